@@ -1,0 +1,68 @@
+//! The one error type of the core. Every fallible public function returns
+//! [`NdtError`]; the Python binding maps it to exceptions in one place.
+
+use thiserror::Error;
+
+/// Everything that can go wrong in the core. Not converging is *not* an error:
+/// it is reported by [`crate::MatchResult::converged`].
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum NdtError {
+    /// A value that must be finite was NaN or infinite.
+    #[error("{what}: expected finite values, got {value} at index {index}")]
+    NonFinite {
+        /// Which argument held the value.
+        what: &'static str,
+        /// Index of the first offending value (point index, or pose component).
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// A point lies so far away that its cell index would overflow.
+    #[error(
+        "{what}: point {index} at ({x}, {y}) m is outside the grid's range of ±{limit} m \
+         (cell index would overflow)"
+    )]
+    CellIndexOverflow {
+        /// Which argument held the point.
+        what: &'static str,
+        /// Index of the point.
+        index: usize,
+        /// Map-frame x of the point [m].
+        x: f64,
+        /// Map-frame y of the point [m].
+        y: f64,
+        /// Largest admissible |coordinate| [m].
+        limit: f64,
+    },
+    /// An input that must hold at least one element held none.
+    #[error("{what}: expected at least one point, got 0")]
+    Empty {
+        /// Which argument was empty.
+        what: &'static str,
+    },
+    /// An option outside its admissible range.
+    #[error("{name}: expected {expected}, got {value}")]
+    InvalidOption {
+        /// The option's name as users spell it.
+        name: &'static str,
+        /// What was expected, in words.
+        expected: &'static str,
+        /// The value that came.
+        value: f64,
+    },
+}
+
+/// Result alias of the core.
+pub type Result<T> = std::result::Result<T, NdtError>;
+
+/// Fails with [`NdtError::NonFinite`] on the first non-finite value.
+pub(crate) fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(NdtError::NonFinite {
+            what,
+            index,
+            value: values[index],
+        }),
+        None => Ok(()),
+    }
+}

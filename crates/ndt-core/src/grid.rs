@@ -1,0 +1,204 @@
+//! The sparse NDT grid map of §III-B: cells keyed by integer index, each
+//! holding only the eq. (6) sums, never the points.
+
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use nalgebra::{Matrix2, Vector2};
+use rustc_hash::{FxHashMap, FxHashSet};
+
+use crate::cell::CellStats;
+use crate::distributions::{DistOptions, Distributions};
+use crate::error::{check_finite, NdtError, Result};
+use crate::key::{CellKey, MAX_INDEX};
+use crate::se2::Pose2;
+
+/// How many prepared distribution sets (one per distinct expansion/fusion
+/// setting) a grid keeps between calls.
+const PREPARED_CAPACITY: usize = 4;
+
+/// One cell as returned to callers: index and the paper's sums in map
+/// coordinates (`m = Σx`, `S = Σ x xᵀ`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CellRecord {
+    /// Cell index.
+    pub key: CellKey,
+    /// `M` of eq. (6).
+    pub count: u64,
+    /// `m = Σ x` in map coordinates [m].
+    pub sum: Vector2<f64>,
+    /// `S = Σ x xᵀ` in map coordinates [m²].
+    pub scatter: Matrix2<f64>,
+}
+
+/// A sparse, unbounded NDT grid map (§III-B).
+///
+/// Memory grows with the mapped area (occupied cells), not with the number of
+/// scans. Distributions for matching are derived from the sums on demand and
+/// kept up to date incrementally under [`NdtGrid::insert`].
+#[derive(Debug)]
+pub struct NdtGrid {
+    cell_size: f64,
+    inv_cell_size: f64,
+    cells: FxHashMap<CellKey, CellStats>,
+    prepared: Mutex<Vec<Arc<Distributions>>>,
+}
+
+impl Clone for NdtGrid {
+    fn clone(&self) -> Self {
+        Self {
+            cell_size: self.cell_size,
+            inv_cell_size: self.inv_cell_size,
+            cells: self.cells.clone(),
+            prepared: Mutex::new(self.lock_prepared().clone()),
+        }
+    }
+}
+
+impl NdtGrid {
+    /// An empty grid with square cells of `cell_size` metres (the paper: 0.02).
+    pub fn new(cell_size: f64) -> Result<Self> {
+        if !(cell_size.is_finite() && cell_size > 0.0) {
+            return Err(NdtError::InvalidOption {
+                name: "cell_size",
+                expected: "a finite cell size > 0 m",
+                value: cell_size,
+            });
+        }
+        Ok(Self {
+            cell_size,
+            inv_cell_size: 1.0 / cell_size,
+            cells: FxHashMap::default(),
+            prepared: Mutex::new(Vec::new()),
+        })
+    }
+
+    /// Cell size [m].
+    pub fn cell_size(&self) -> f64 {
+        self.cell_size
+    }
+
+    /// 1 / cell size [1/m].
+    pub(crate) fn inv_cell_size(&self) -> f64 {
+        self.inv_cell_size
+    }
+
+    /// Number of cells holding at least one point.
+    pub fn len(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// `true` when no point was ever inserted.
+    pub fn is_empty(&self) -> bool {
+        self.cells.is_empty()
+    }
+
+    /// Largest |map coordinate| a point may have [m].
+    pub fn coordinate_limit(&self) -> f64 {
+        f64::from(MAX_INDEX) * self.cell_size
+    }
+
+    /// The sums of one cell about its centre, if it holds points.
+    pub fn stats(&self, key: CellKey) -> Option<&CellStats> {
+        self.cells.get(&key)
+    }
+
+    /// Every occupied cell with its eq. (6) sums in map coordinates, sorted by
+    /// key (`ix`, then `iy`) so the order is deterministic.
+    pub fn cells(&self) -> Vec<CellRecord> {
+        let mut out: Vec<CellRecord> = self
+            .cells
+            .iter()
+            .map(|(&key, s)| {
+                // Back from "about the centre c" to "about the origin": shift by −c.
+                let abs = s.shifted(-key.center(self.cell_size));
+                CellRecord {
+                    key,
+                    count: abs.count,
+                    sum: abs.sum,
+                    scatter: abs.scatter,
+                }
+            })
+            .collect();
+        out.sort_unstable_by_key(|r| r.key);
+        out
+    }
+
+    /// eq. (6): adds the scan-frame `points` [m] seen from `pose`
+    /// (`T_map_scan`) to the grid. All-or-nothing: on error (non-finite input,
+    /// a point whose cell index would overflow) the grid is unchanged.
+    ///
+    /// Returns the keys of the cells that changed (each once, first-touch order).
+    pub fn insert(&mut self, points: &[[f64; 2]], pose: Pose2) -> Result<Vec<CellKey>> {
+        check_finite("pose", &pose.to_array())?;
+        check_points("points", points)?;
+        // Validate everything before touching the map.
+        let mut staged: Vec<(CellKey, Vector2<f64>)> = Vec::with_capacity(points.len());
+        for (index, p) in points.iter().enumerate() {
+            let w = pose.transform(Vector2::new(p[0], p[1]));
+            let key = CellKey::of(w, self.inv_cell_size).ok_or(NdtError::CellIndexOverflow {
+                what: "points",
+                index,
+                x: w.x,
+                y: w.y,
+                limit: self.coordinate_limit(),
+            })?;
+            staged.push((key, w));
+        }
+        let mut seen = FxHashSet::default();
+        let mut touched = Vec::new();
+        for (key, w) in staged {
+            if seen.insert(key) {
+                touched.push(key);
+            }
+            let c = key.center(self.cell_size);
+            self.cells.entry(key).or_default().add_point(w - c);
+        }
+        let cell_size = self.cell_size;
+        let cells = &self.cells;
+        let prepared = self.prepared.get_mut().unwrap_or_else(|e| e.into_inner());
+        for dist in prepared.iter_mut() {
+            Arc::make_mut(dist).update(cells, cell_size, &touched);
+        }
+        Ok(touched)
+    }
+
+    /// The distributions for `options`, built on first use and then kept up to
+    /// date by [`NdtGrid::insert`].
+    pub(crate) fn distributions(&self, options: DistOptions) -> Arc<Distributions> {
+        let mut prepared = self.lock_prepared();
+        if let Some(found) = prepared.iter().find(|d| d.options() == options) {
+            return Arc::clone(found);
+        }
+        let built = Arc::new(Distributions::build(&self.cells, self.cell_size, options));
+        if prepared.len() >= PREPARED_CAPACITY {
+            prepared.remove(0);
+        }
+        prepared.push(Arc::clone(&built));
+        built
+    }
+
+    fn lock_prepared(&self) -> MutexGuard<'_, Vec<Arc<Distributions>>> {
+        // A poisoned lock only means another thread panicked while holding it;
+        // the cache is rebuilt from the sums, so its content is still usable.
+        self.prepared.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// Rejects non-finite points.
+pub(crate) fn check_points(what: &'static str, points: &[[f64; 2]]) -> Result<()> {
+    match points
+        .iter()
+        .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+    {
+        Some(index) => Err(NdtError::NonFinite {
+            what,
+            index,
+            value: if points[index][0].is_finite() {
+                points[index][1]
+            } else {
+                points[index][0]
+            },
+        }),
+        None => Ok(()),
+    }
+}

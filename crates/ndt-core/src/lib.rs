@@ -1,0 +1,35 @@
+//! # ndt-core
+//!
+//! The algorithms of ndtgrid, free of Python: a sparse high-resolution NDT
+//! grid map and Newton scan matching after Takubo et al., "NDT Scan Matching
+//! Method for High Resolution Grid Map" (IROS 2009), building on Biber &
+//! Strasser (IROS 2003).
+//!
+//! - [`NdtGrid`]: cells keep `M, m, S` (eq. 6) and give eq. (7) distributions;
+//! - [`NdtGrid::match_scan`]: Newton's method on the score of eq. (1) with
+//!   analytic per-point gradient and Hessian (eq. 3–5) and the small-cell fixes
+//!   of §IV-A (neighbour search, expansion by `k` of eq. 8, minority fusion).
+//!
+//! Units: metres and radians. Poses are `T_map_scan` (see [`Pose2`]).
+#![deny(missing_docs)]
+#![warn(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+pub mod cell;
+pub mod distributions;
+pub mod error;
+pub mod grid;
+pub mod key;
+pub mod matcher;
+pub mod neighbor;
+pub mod score;
+pub mod se2;
+pub mod solver;
+
+pub use cell::{CellStats, Gaussian};
+pub use error::{NdtError, Result};
+pub use grid::{CellRecord, NdtGrid};
+pub use key::CellKey;
+pub use matcher::{MatchOptions, MatchResult};
+pub use score::{Order, ScoreTerms};
+pub use se2::{wrap_angle, Pose2};
+pub use solver::SolverOptions;

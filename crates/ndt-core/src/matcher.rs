@@ -1,0 +1,237 @@
+//! NDT scan matching against an [`NdtGrid`] (§III-A with the fixes of §IV-A).
+
+use nalgebra::{Matrix3, Vector2};
+
+use crate::cell::Gaussian;
+use crate::distributions::{DistOptions, Distributions};
+use crate::error::{check_finite, NdtError, Result};
+use crate::grid::{check_points, NdtGrid};
+use crate::key::CellKey;
+use crate::neighbor::nearest_in_rings;
+use crate::score::{Order, ScoreTerms};
+use crate::se2::Pose2;
+use crate::solver::{covariance_from_hessian, minimise, SolverOptions};
+
+/// Largest admissible neighbour-search radius [cells].
+pub const MAX_SEARCH_RADIUS: u32 = 1000;
+
+/// Options of [`NdtGrid::match_scan`]. The defaults are the paper's method
+/// (§IV-A): `k = 10`, neighbour search and fusion on. The original NDT of
+/// Biber & Strasser on the same grid is `expansion = 1`,
+/// `neighbor_search = false`, `fuse_minority = false`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MatchOptions {
+    /// `k` of eq. (8) (> 0; 1 = no expansion).
+    pub expansion: f64,
+    /// §IV-A(1): pair points whose own cell has no distribution with a nearby
+    /// cell's (see [`crate::neighbor::nearest_in_rings`]).
+    pub neighbor_search: bool,
+    /// Neighbour-search radius [cells] (Chebyshev distance), ≤ [`MAX_SEARCH_RADIUS`].
+    pub search_radius: u32,
+    /// §IV-A(3): fuse cells with fewer than 3 points with their neighbours.
+    pub fuse_minority: bool,
+    /// Newton iterations at most.
+    pub max_iterations: u32,
+    /// Convergence threshold on the translation step [m].
+    pub translation_tolerance: f64,
+    /// Convergence threshold on the rotation step [rad].
+    pub rotation_tolerance: f64,
+    /// Largest translation per Newton step [cells]. With 2 cm cells a long
+    /// step jumps past the narrow basin (§IV-A); 2 cells keeps it inside.
+    pub max_step_cells: f64,
+    /// Largest rotation per Newton step [rad].
+    pub max_step_rotation: f64,
+}
+
+impl Default for MatchOptions {
+    fn default() -> Self {
+        Self {
+            expansion: 10.0,
+            neighbor_search: true,
+            search_radius: 3,
+            fuse_minority: true,
+            max_iterations: 50,
+            translation_tolerance: 1e-5,
+            rotation_tolerance: 1e-5,
+            max_step_cells: 2.0,
+            max_step_rotation: 0.05,
+        }
+    }
+}
+
+impl MatchOptions {
+    /// Checks every option's range.
+    pub fn validate(&self) -> Result<()> {
+        let positive = |name: &'static str, value: f64| {
+            if value.is_finite() && value > 0.0 {
+                Ok(())
+            } else {
+                Err(NdtError::InvalidOption {
+                    name,
+                    expected: "a finite value > 0",
+                    value,
+                })
+            }
+        };
+        positive("expansion", self.expansion)?;
+        positive("translation_tolerance", self.translation_tolerance)?;
+        positive("rotation_tolerance", self.rotation_tolerance)?;
+        positive("max_step_cells", self.max_step_cells)?;
+        positive("max_step_rotation", self.max_step_rotation)?;
+        if self.search_radius > MAX_SEARCH_RADIUS {
+            return Err(NdtError::InvalidOption {
+                name: "search_radius",
+                expected: "a radius of at most 1000 cells",
+                value: f64::from(self.search_radius),
+            });
+        }
+        Ok(())
+    }
+
+    fn solver_options(&self, cell_size: f64) -> SolverOptions {
+        SolverOptions {
+            max_iterations: self.max_iterations,
+            translation_tolerance: self.translation_tolerance,
+            rotation_tolerance: self.rotation_tolerance,
+            max_step_translation: self.max_step_cells * cell_size,
+            max_step_rotation: self.max_step_rotation,
+        }
+    }
+
+    fn dist_options(&self) -> DistOptions {
+        DistOptions {
+            expansion: self.expansion,
+            fuse_minority: self.fuse_minority,
+        }
+    }
+}
+
+/// The outcome of one match.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MatchResult {
+    /// Best pose `T_map_scan` found.
+    pub pose: Pose2,
+    /// The solver met its step tolerance (not merely ran out of iterations).
+    pub converged: bool,
+    /// Newton steps taken.
+    pub iterations: u32,
+    /// `E(p)` of eq. (1) at `pose`, with the distributions used.
+    pub score: f64,
+    /// Points that had a reference distribution at `pose`.
+    pub num_matched: usize,
+    /// Hessian of `−E` at `pose` (order `tx, ty, θ`).
+    pub hessian: Matrix3<f64>,
+    /// Pose covariance estimate, see [`covariance_from_hessian`].
+    pub covariance: Matrix3<f64>,
+}
+
+/// The distribution a map-frame point is paired with: its own cell's, else
+/// (with neighbour search) the nearest one found ring by ring.
+#[inline]
+fn pair<'a>(
+    dists: &'a Distributions,
+    xw: Vector2<f64>,
+    inv_cell: f64,
+    options: &MatchOptions,
+) -> Option<&'a Gaussian> {
+    let key = CellKey::of(xw, inv_cell)?;
+    match dists.get(key) {
+        Some(g) => Some(g),
+        None if options.neighbor_search => nearest_in_rings(dists, xw, key, options.search_radius),
+        None => None,
+    }
+}
+
+/// Score terms of the whole scan at `pose`.
+pub(crate) fn evaluate(
+    dists: &Distributions,
+    points: &[[f64; 2]],
+    pose: Pose2,
+    inv_cell: f64,
+    options: &MatchOptions,
+    order: Order,
+) -> ScoreTerms {
+    let sin_cos = pose.theta.sin_cos();
+    let mut terms = ScoreTerms::default();
+    for p in points {
+        let x = Vector2::new(p[0], p[1]);
+        let xw = pose.transform(x);
+        if let Some(g) = pair(dists, xw, inv_cell, options) {
+            terms.add(x, xw, sin_cos, g, order);
+        }
+    }
+    terms
+}
+
+impl NdtGrid {
+    /// Matches scan-frame `points` [m] against the grid from `guess`
+    /// (`T_map_scan`) by Newton's method on eq. (1).
+    ///
+    /// Errors on empty or non-finite input, on points beyond
+    /// [`NdtGrid::coordinate_limit`], and on invalid options; never on a
+    /// failed solve (see [`MatchResult::converged`]).
+    pub fn match_scan(
+        &self,
+        points: &[[f64; 2]],
+        guess: Pose2,
+        options: &MatchOptions,
+    ) -> Result<MatchResult> {
+        options.validate()?;
+        check_finite("guess", &guess.to_array())?;
+        if points.is_empty() {
+            return Err(NdtError::Empty { what: "points" });
+        }
+        check_points("points", points)?;
+        let limit = self.coordinate_limit();
+        if let Some(index) = points
+            .iter()
+            .position(|p| p[0].abs() >= limit || p[1].abs() >= limit)
+        {
+            return Err(NdtError::CellIndexOverflow {
+                what: "points",
+                index,
+                x: points[index][0],
+                y: points[index][1],
+                limit,
+            });
+        }
+        let dists = self.distributions(options.dist_options());
+        let inv_cell = self.inv_cell_size();
+        let solver = options.solver_options(self.cell_size());
+        let outcome = minimise(guess, &solver, |pose, order| {
+            evaluate(&dists, points, pose, inv_cell, options, order)
+        });
+        let hessian = outcome.terms.hessian;
+        Ok(MatchResult {
+            pose: outcome.pose,
+            converged: outcome.converged,
+            iterations: outcome.iterations,
+            score: outcome.terms.score,
+            num_matched: outcome.terms.matched,
+            hessian,
+            covariance: covariance_from_hessian(&hessian),
+        })
+    }
+
+    /// `E(p)`, `∇(−E)` and `∇²(−E)` of eq. (1) for `points` at `pose`, without
+    /// solving (score landscapes, diagnostics, finite-difference checks).
+    pub fn score_terms(
+        &self,
+        points: &[[f64; 2]],
+        pose: Pose2,
+        options: &MatchOptions,
+    ) -> Result<ScoreTerms> {
+        options.validate()?;
+        check_finite("pose", &pose.to_array())?;
+        check_points("points", points)?;
+        let dists = self.distributions(options.dist_options());
+        Ok(evaluate(
+            &dists,
+            points,
+            pose,
+            self.inv_cell_size(),
+            options,
+            Order::Derivatives,
+        ))
+    }
+}

@@ -1,0 +1,44 @@
+//! §IV-A(1) neighbour search: a point whose own cell has no distribution is
+//! paired with a nearby cell's, found ring by ring (Elias method).
+
+use nalgebra::Vector2;
+
+use crate::cell::Gaussian;
+use crate::distributions::Distributions;
+use crate::key::CellKey;
+
+/// Pairing rule: search the square rings at Chebyshev distance 1, 2, …,
+/// `radius` (in cells) around the point's own cell; in the first ring that
+/// holds any distribution, take the one whose mean is nearest to the point
+/// (Euclidean). `None` when no ring up to `radius` holds one.
+pub fn nearest_in_rings(
+    dists: &Distributions,
+    point: Vector2<f64>,
+    key: CellKey,
+    radius: u32,
+) -> Option<&Gaussian> {
+    let radius = i32::try_from(radius).unwrap_or(i32::MAX);
+    for r in 1..=radius {
+        let mut best: Option<(f64, &Gaussian)> = None;
+        let mut consider = |dx: i32, dy: i32| {
+            if let Some(g) = dists.get(key.offset(dx, dy)) {
+                let d2 = (g.mean - point).norm_squared();
+                if best.is_none_or(|(b, _)| d2 < b) {
+                    best = Some((d2, g));
+                }
+            }
+        };
+        for dx in -r..=r {
+            consider(dx, -r);
+            consider(dx, r);
+        }
+        for dy in (-r + 1)..r {
+            consider(-r, dy);
+            consider(r, dy);
+        }
+        if let Some((_, g)) = best {
+            return Some(g);
+        }
+    }
+    None
+}

@@ -1,0 +1,90 @@
+//! The NDT score of eq. (1) and its analytic gradient and Hessian (eq. 3–5),
+//! accumulated point by point. The solver minimises `f(p) = −E(p)`.
+
+use nalgebra::{Matrix3, Vector2, Vector3};
+
+use crate::cell::Gaussian;
+
+/// How much of the score's Taylor expansion to accumulate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Order {
+    /// `E` only (line search).
+    Value,
+    /// `E`, `∇f` and `∇²f` (Newton step).
+    Derivatives,
+}
+
+/// Accumulated `E(p)` (eq. 1) with the gradient `g` and Hessian `H` of
+/// `f = −E` with respect to `p = (tx, ty, θ)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScoreTerms {
+    /// `E(p) = Σᵢ exp(−½ dᵢᵀ Σᵢ⁻¹ dᵢ)` over paired points (eq. 1).
+    pub score: f64,
+    /// `g = ∇(−E)` [1/m, 1/m, 1/rad].
+    pub gradient: Vector3<f64>,
+    /// `H = ∇²(−E)`.
+    pub hessian: Matrix3<f64>,
+    /// Points that had a reference distribution.
+    pub matched: usize,
+}
+
+impl Default for ScoreTerms {
+    fn default() -> Self {
+        Self {
+            score: 0.0,
+            gradient: Vector3::zeros(),
+            hessian: Matrix3::zeros(),
+            matched: 0,
+        }
+    }
+}
+
+impl ScoreTerms {
+    /// Adds point `x` (scan frame) mapped to `xw = R(θ) x + t` (eq. 2) and
+    /// paired with `dist`. `(sin θ, cos θ)` are passed in so they are computed
+    /// once per pose, not per point.
+    ///
+    /// With `d = x' − q`, `C = Σ⁻¹`, `s = exp(−½ dᵀ C d)`,
+    /// `J = ∂x'/∂p = [[1, 0, a], [0, 1, b]]`, `a = −x sinθ − y cosθ`,
+    /// `b = x cosθ − y sinθ`:
+    /// - `gₖ += s · dᵀ C Jₖ` (eq. 4 for `f = −E`),
+    /// - `Hₖₗ += s · (−(dᵀ C Jₖ)(dᵀ C Jₗ) + Jₗᵀ C Jₖ + dᵀ C ∂²x'/∂pₖ∂pₗ)` (eq. 5),
+    ///   where only `∂²x'/∂θ² = (−x cosθ + y sinθ, −x sinθ − y cosθ)` is non-zero.
+    #[inline]
+    pub fn add(
+        &mut self,
+        x: Vector2<f64>,
+        xw: Vector2<f64>,
+        sin_cos: (f64, f64),
+        dist: &Gaussian,
+        order: Order,
+    ) {
+        let d = xw - dist.mean;
+        let c = &dist.inverse;
+        let (c00, c01, c11) = (c[(0, 0)], c[(0, 1)], c[(1, 1)]);
+        let cd0 = c00 * d.x + c01 * d.y;
+        let cd1 = c01 * d.x + c11 * d.y;
+        let e = d.x * cd0 + d.y * cd1;
+        // eq. (1): one point's contribution.
+        let s = (-0.5 * e).exp();
+        self.score += s;
+        self.matched += 1;
+        if order == Order::Value {
+            return;
+        }
+        let (sn, cs) = sin_cos;
+        let a = -x.x * sn - x.y * cs;
+        let b = x.x * cs - x.y * sn;
+        // u_k = dᵀ C J_k
+        let u = Vector3::new(cd0, cd1, cd0 * a + cd1 * b);
+        self.gradient += u * s;
+        // J_lᵀ C J_k
+        let m02 = c00 * a + c01 * b;
+        let m12 = c01 * a + c11 * b;
+        let m22 = a * m02 + b * m12;
+        // dᵀ C ∂²x'/∂θ²
+        let second = cd0 * (-x.x * cs + x.y * sn) + cd1 * (-x.x * sn - x.y * cs);
+        let jcj = Matrix3::new(c00, c01, m02, c01, c11, m12, m02, m12, m22 + second);
+        self.hessian += (jcj - u * u.transpose()) * s;
+    }
+}

@@ -1,0 +1,167 @@
+//! Newton's method on `f = −E` (eq. 3): `Δp = −H⁻¹ g`, made robust far from
+//! the optimum, where `H` need not be positive definite.
+//!
+//! Step control, in this order:
+//! 1. the Hessian's eigenvalues are replaced by their absolute values, floored
+//!    at `1e-9 · max|λ|` (a "saddle-free" Newton step, always a descent
+//!    direction);
+//! 2. the step is scaled down to at most `max_step_translation` metres and
+//!    `max_step_rotation` radians;
+//! 3. a backtracking line search halves the step (at most 12 times) until
+//!    `f` decreases by the Armijo condition `f(p + αΔp) ≤ f(p) + 1e-4 α gᵀΔp`.
+//!
+//! Convergence: the accepted step is below `translation_tolerance` [m] and
+//! `rotation_tolerance` [rad]. Running out of iterations, losing every
+//! paired point or a failed line search end the solve with `converged = false`.
+
+use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+
+use crate::score::{Order, ScoreTerms};
+use crate::se2::Pose2;
+
+const MAX_HALVINGS: u32 = 12;
+const ARMIJO: f64 = 1e-4;
+/// Relative floor of the Hessian's eigenvalues in the Newton step.
+const EIGEN_FLOOR: f64 = 1e-9;
+
+/// Solver settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverOptions {
+    /// Newton iterations at most.
+    pub max_iterations: u32,
+    /// Convergence threshold on the translation step [m].
+    pub translation_tolerance: f64,
+    /// Convergence threshold on the rotation step [rad].
+    pub rotation_tolerance: f64,
+    /// Largest translation per iteration [m].
+    pub max_step_translation: f64,
+    /// Largest rotation per iteration [rad].
+    pub max_step_rotation: f64,
+}
+
+impl Default for SolverOptions {
+    fn default() -> Self {
+        Self {
+            max_iterations: 50,
+            translation_tolerance: 1e-5,
+            rotation_tolerance: 1e-5,
+            max_step_translation: 0.04,
+            max_step_rotation: 0.05,
+        }
+    }
+}
+
+/// What the solver ended with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverOutcome {
+    /// Final pose.
+    pub pose: Pose2,
+    /// The step tolerance was met.
+    pub converged: bool,
+    /// Newton steps taken.
+    pub iterations: u32,
+    /// Score, gradient and Hessian at `pose`.
+    pub terms: ScoreTerms,
+}
+
+/// `x ↦ V diag(1 / max(|λ|, floor)) Vᵀ x`: the inverse of the "absolute" Hessian.
+fn solve_absolute(h: &Matrix3<f64>, rhs: &Vector3<f64>) -> Vector3<f64> {
+    let eig = SymmetricEigen::new(*h);
+    let scale = eig.eigenvalues.iter().fold(0.0_f64, |m, l| m.max(l.abs()));
+    let floor = (EIGEN_FLOOR * scale).max(f64::MIN_POSITIVE);
+    let v = &eig.eigenvectors;
+    let mut out = Vector3::zeros();
+    for i in 0..3 {
+        let col = v.column(i);
+        let lam = eig.eigenvalues[i].abs().max(floor);
+        out += col * (col.dot(rhs) / lam);
+    }
+    out
+}
+
+/// Pose covariance estimate `H⁻¹` of `−E` at the optimum (Laplace
+/// approximation, treating `E` as a log-likelihood). Eigenvalues of `H` below
+/// `1e-9 · max|λ|` (directions the scan does not constrain) are floored there,
+/// so those directions get a very large, finite variance.
+pub fn covariance_from_hessian(h: &Matrix3<f64>) -> Matrix3<f64> {
+    let eig = SymmetricEigen::new(*h);
+    let scale = eig.eigenvalues.iter().fold(0.0_f64, |m, l| m.max(l.abs()));
+    let floor = (EIGEN_FLOOR * scale).max(1e-300);
+    let v = &eig.eigenvectors;
+    let mut out = Matrix3::zeros();
+    for i in 0..3 {
+        let col = v.column(i);
+        let lam = eig.eigenvalues[i].max(floor);
+        out += col * col.transpose() / lam;
+    }
+    out
+}
+
+fn capped(step: Vector3<f64>, opts: &SolverOptions) -> Vector3<f64> {
+    let t = (step.x * step.x + step.y * step.y).sqrt();
+    let r = step.z.abs();
+    let mut scale: f64 = 1.0;
+    if t > opts.max_step_translation {
+        scale = scale.min(opts.max_step_translation / t);
+    }
+    if r > opts.max_step_rotation {
+        scale = scale.min(opts.max_step_rotation / r);
+    }
+    step * scale
+}
+
+fn moved(p: Pose2, step: Vector3<f64>) -> Pose2 {
+    Pose2::new(p.x + step.x, p.y + step.y, p.theta + step.z)
+}
+
+/// Minimises `f = −E` from `guess`; `eval(p, order)` accumulates the score
+/// terms at `p`.
+pub fn minimise<F>(guess: Pose2, opts: &SolverOptions, mut eval: F) -> SolverOutcome
+where
+    F: FnMut(Pose2, Order) -> ScoreTerms,
+{
+    let mut pose = guess;
+    let mut terms = eval(pose, Order::Derivatives);
+    let mut converged = false;
+    let mut iterations = 0;
+    while iterations < opts.max_iterations && terms.matched > 0 {
+        // eq. (3): Δp = −H⁻¹ g (with the absolute, floored Hessian).
+        let step = capped(-solve_absolute(&terms.hessian, &terms.gradient), opts);
+        if (step.x * step.x + step.y * step.y).sqrt() < opts.translation_tolerance
+            && step.z.abs() < opts.rotation_tolerance
+        {
+            converged = true;
+            break;
+        }
+        let f0 = -terms.score;
+        let slope = terms.gradient.dot(&step);
+        let mut alpha = 1.0;
+        let mut accepted = None;
+        for _ in 0..=MAX_HALVINGS {
+            let candidate = moved(pose, step * alpha);
+            let f = -eval(candidate, Order::Value).score;
+            if f <= f0 + ARMIJO * alpha * slope {
+                accepted = Some(candidate);
+                break;
+            }
+            alpha *= 0.5;
+        }
+        let Some(next) = accepted else { break };
+        iterations += 1;
+        pose = next;
+        terms = eval(pose, Order::Derivatives);
+        let taken = step * alpha;
+        if (taken.x * taken.x + taken.y * taken.y).sqrt() < opts.translation_tolerance
+            && taken.z.abs() < opts.rotation_tolerance
+        {
+            converged = true;
+            break;
+        }
+    }
+    SolverOutcome {
+        pose,
+        converged,
+        iterations,
+        terms,
+    }
+}

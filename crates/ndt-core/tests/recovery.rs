@@ -1,0 +1,77 @@
+//! A synthetic scan is recovered from offsets inside the basin.
+
+mod common;
+
+use ndt_core::{MatchOptions, NdtGrid, Pose2};
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+
+fn dense_map(cell: f64) -> NdtGrid {
+    let walls = common::room();
+    let mut grid = NdtGrid::new(cell).unwrap();
+    // A few noise-free scans from nearby poses, as a map is built.
+    for (i, p) in [
+        (0.0, 0.0, 0.0),
+        (0.3, 0.2, 1.0),
+        (-0.4, -0.3, 2.5),
+        (0.5, -0.5, -1.8),
+    ]
+    .iter()
+    .enumerate()
+    {
+        let pose = Pose2::new(p.0, p.1, p.2);
+        grid.insert(&common::urg_scan(&walls, pose, 0.0, i as u64), pose)
+            .unwrap();
+    }
+    grid
+}
+
+fn recover(cell: f64, max_t: f64, max_r_deg: f64, seed: u64) {
+    let walls = common::room();
+    let grid = dense_map(cell);
+    let truth = Pose2::new(0.12, -0.08, 0.2);
+    let scan = common::urg_scan(&walls, truth, 0.0, 99);
+    let mut rng = StdRng::seed_from_u64(seed);
+    for _ in 0..20 {
+        let guess = Pose2::new(
+            truth.x + rng.random_range(-max_t..max_t),
+            truth.y + rng.random_range(-max_t..max_t),
+            truth.theta + rng.random_range(-max_r_deg..max_r_deg).to_radians(),
+        );
+        let res = grid
+            .match_scan(&scan, guess, &MatchOptions::default())
+            .unwrap();
+        let dt = ((res.pose.x - truth.x).powi(2) + (res.pose.y - truth.y).powi(2)).sqrt();
+        let dr = (res.pose.theta - truth.theta).abs().to_degrees();
+        assert!(res.converged, "{res:?} from {guess:?}");
+        assert!(dt < 1e-3, "translation error {dt} m from {guess:?}");
+        assert!(dr < 0.05, "rotation error {dr}° from {guess:?}");
+    }
+}
+
+#[test]
+fn recovers_synthetic_scan_on_2cm_grid() {
+    recover(0.02, 0.05, 1.5, 1);
+}
+
+#[test]
+fn recovers_synthetic_scan_on_20cm_grid() {
+    recover(0.2, 0.08, 3.0, 2);
+}
+
+#[test]
+fn empty_grid_does_not_converge_and_empty_scan_is_an_error() {
+    let grid = NdtGrid::new(0.02).unwrap();
+    let res = grid
+        .match_scan(&[[1.0, 0.0]], Pose2::identity(), &MatchOptions::default())
+        .unwrap();
+    assert!(!res.converged);
+    assert_eq!(res.num_matched, 0);
+    let err = grid
+        .match_scan(&[], Pose2::identity(), &MatchOptions::default())
+        .unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "points: expected at least one point, got 0"
+    );
+}
