@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import require_real
+from ._data import require_real
 from ndtgrid.io import OdomRecord, Scan, iter_carmen_messages, read_carmen
 
 INTEL = "radish-gfs-corrected/intel-corrected.log.gz"

@@ -1,1 +1,84 @@
+//! `cargo bench`: insert and match of 180-, 361- and 683-point scans on 2 cm
+//! and 20 cm grids (one core, one thread).
+//!
+//! The map is the synthetic room of the tests, built from eight scans; the
+//! matched scan is taken 3 cm / 1° away from its guess.
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use ndt_core::{MatchOptions, NdtGrid, Pose2};
+
+const BEAMS: [usize; 3] = [180, 361, 683];
+const CELLS: [f64; 2] = [0.02, 0.2];
+
+fn scan(beams: usize, pose: Pose2, seed: u64) -> Vec<[f64; 2]> {
+    let fov = if beams == 683 { 240f64 } else { 180f64 };
+    common::scan(&common::room(), pose, beams, fov.to_radians(), 0.01, seed)
+}
+
+fn map(beams: usize, cell: f64) -> NdtGrid {
+    let mut grid = NdtGrid::new(cell).unwrap_or_else(|e| panic!("{e}"));
+    for i in 0..8u32 {
+        let a = f64::from(i) * 0.8;
+        let pose = Pose2::new(0.3 * a.cos(), 0.2 * a.sin(), a);
+        grid.insert(&scan(beams, pose, u64::from(i)), pose)
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
+    grid
+}
+
+fn bench_insert(c: &mut Criterion) {
+    let mut group = c.benchmark_group("insert");
+    for cell in CELLS {
+        for beams in BEAMS {
+            let grid = map(beams, cell);
+            let pose = Pose2::new(0.1, -0.05, 0.3);
+            let pts = scan(beams, pose, 42);
+            // A SLAM loop's map has its distributions built: insert keeps them
+            // up to date, and that is part of what is timed.
+            let _ = grid.match_scan(&pts, pose, &MatchOptions::default());
+            group.throughput(Throughput::Elements(pts.len() as u64));
+            group.bench_with_input(
+                BenchmarkId::new(format!("cell_{}cm", cell * 100.0), beams),
+                &pts,
+                |b, pts| {
+                    b.iter_batched_ref(
+                        || grid.clone(),
+                        |g| g.insert(black_box(pts), pose),
+                        criterion::BatchSize::LargeInput,
+                    )
+                },
+            );
+        }
+    }
+    group.finish();
+}
+
+fn bench_match(c: &mut Criterion) {
+    let mut group = c.benchmark_group("match");
+    for cell in CELLS {
+        for beams in BEAMS {
+            let grid = map(beams, cell);
+            let truth = Pose2::new(0.1, -0.05, 0.3);
+            let pts = scan(beams, truth, 42);
+            let guess = Pose2::new(truth.x + 0.03, truth.y - 0.02, truth.theta + 0.017);
+            let options = MatchOptions::default();
+            // Build the distributions once, as a SLAM loop's map already has them.
+            let _ = grid.match_scan(&pts, guess, &options);
+            group.throughput(Throughput::Elements(pts.len() as u64));
+            group.bench_with_input(
+                BenchmarkId::new(format!("cell_{}cm", cell * 100.0), beams),
+                &pts,
+                |b, pts| b.iter(|| grid.match_scan(black_box(pts), guess, &options)),
+            );
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_insert, bench_match);
+criterion_main!(benches);

@@ -100,14 +100,13 @@ pub fn symmetric_eigen2(m: &Matrix2<f64>) -> (f64, f64, Vector2<f64>) {
 }
 
 /// A cell's normal distribution as the matcher uses it: mean `q` [m, map
-/// frame], the regularised and expanded covariance `Σ'` [m²] and its inverse.
+/// frame] and the inverse of the regularised, expanded covariance `Σ'`
+/// (kept compact: this is what the matcher's inner loop reads).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Gaussian {
     /// `q` of eq. (7), map frame [m].
     pub mean: Vector2<f64>,
-    /// `Σ' = V diag(kλ₁, kλ₂) Vᵀ` of eq. (8), after regularisation [m²].
-    pub covariance: Matrix2<f64>,
-    /// `Σ'⁻¹` [1/m²].
+    /// `Σ'⁻¹` [1/m²], with `Σ' = V diag(kλ₁, kλ₂) Vᵀ` of eq. (8).
     pub inverse: Matrix2<f64>,
 }
 
@@ -132,12 +131,17 @@ impl Gaussian {
         // eq. (8): expand both eigenvalues by k.
         let (e1, e2) = (k * l1, k * l2);
         let v2 = Vector2::new(-v1.y, v1.x);
-        let covariance = v1 * v1.transpose() * e1 + v2 * v2.transpose() * e2;
         let inverse = v1 * v1.transpose() / e1 + v2 * v2.transpose() / e2;
         Some(Gaussian {
             mean: origin + q,
-            covariance,
             inverse,
         })
+    }
+
+    /// `Σ'` [m²]: the regularised, expanded covariance (eq. 8).
+    pub fn covariance(&self) -> Matrix2<f64> {
+        let c = &self.inverse;
+        let det = c[(0, 0)] * c[(1, 1)] - c[(0, 1)] * c[(1, 0)];
+        Matrix2::new(c[(1, 1)], -c[(0, 1)], -c[(1, 0)], c[(0, 0)]) / det
     }
 }

@@ -59,14 +59,17 @@ impl Distributions {
     ) {
         let mut affected: FxHashSet<CellKey> = FxHashSet::default();
         for &key in touched {
+            affected.insert(key);
             if self.options.fuse_minority {
+                // Only minority neighbours use the fused sums that include `key`.
                 for dy in -1..=1 {
                     for dx in -1..=1 {
-                        affected.insert(key.offset(dx, dy));
+                        let n = key.offset(dx, dy);
+                        if cells.get(&n).is_some_and(|s| s.count < MIN_POINTS) {
+                            affected.insert(n);
+                        }
                     }
                 }
-            } else {
-                affected.insert(key);
             }
         }
         for key in affected {

@@ -19,8 +19,10 @@ pub enum NdtError {
     },
     /// A point lies so far away that its cell index would overflow.
     #[error(
-        "{what}: point {index} at ({x}, {y}) m is outside the grid's range of ±{limit} m \
-         (cell index would overflow)"
+        "{what}: point {index} at ({}, {}) m is outside the grid's range of ±{limit} m \
+         (cell index would overflow)",
+        Num(*.x),
+        Num(*.y)
     )]
     CellIndexOverflow {
         /// Which argument held the point.
@@ -50,6 +52,21 @@ pub enum NdtError {
         /// The value that came.
         value: f64,
     },
+}
+
+/// Displays a number plainly, or in scientific notation when it is very large
+/// or very small, so messages stay short.
+struct Num(f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a >= 1e7 || (a > 0.0 && a < 1e-4) {
+            write!(f, "{:e}", self.0)
+        } else {
+            write!(f, "{}", self.0)
+        }
+    }
 }
 
 /// Result alias of the core.

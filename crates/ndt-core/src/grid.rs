@@ -49,7 +49,14 @@ impl Clone for NdtGrid {
             cell_size: self.cell_size,
             inv_cell_size: self.inv_cell_size,
             cells: self.cells.clone(),
-            prepared: Mutex::new(self.lock_prepared().clone()),
+            // Deep copies, so that the clone's inserts update its own
+            // distributions in place instead of copying them on first write.
+            prepared: Mutex::new(
+                self.lock_prepared()
+                    .iter()
+                    .map(|d| Arc::new(Distributions::clone(d)))
+                    .collect(),
+            ),
         }
     }
 }

@@ -26,6 +26,7 @@ pub mod se2;
 pub mod solver;
 
 pub use cell::{CellStats, Gaussian};
+pub use nalgebra;
 pub use error::{NdtError, Result};
 pub use grid::{CellRecord, NdtGrid};
 pub use key::CellKey;

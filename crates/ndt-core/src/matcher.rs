@@ -51,8 +51,8 @@ impl Default for MatchOptions {
             search_radius: 3,
             fuse_minority: true,
             max_iterations: 50,
-            translation_tolerance: 1e-5,
-            rotation_tolerance: 1e-5,
+            translation_tolerance: 1e-4,
+            rotation_tolerance: 1e-4,
             max_step_cells: 2.0,
             max_step_rotation: 0.05,
         }

@@ -10,9 +10,12 @@
 //! 3. a backtracking line search halves the step (at most 12 times) until
 //!    `f` decreases by the Armijo condition `f(p + αΔp) ≤ f(p) + 1e-4 α gᵀΔp`.
 //!
-//! Convergence: the accepted step is below `translation_tolerance` [m] and
-//! `rotation_tolerance` [rad]. Running out of iterations, losing every
-//! paired point or a failed line search end the solve with `converged = false`.
+//! Convergence (`converged = true`): a step below `translation_tolerance` [m]
+//! and `rotation_tolerance` [rad] — the full Newton step, the step the line
+//! search accepted, or the largest step it tried without finding a decrease
+//! (a local optimum of the piecewise-smooth score at that resolution).
+//! Running out of iterations or losing every paired point end the solve with
+//! `converged = false`.
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
@@ -43,8 +46,8 @@ impl Default for SolverOptions {
     fn default() -> Self {
         Self {
             max_iterations: 50,
-            translation_tolerance: 1e-5,
-            rotation_tolerance: 1e-5,
+            translation_tolerance: 1e-4,
+            rotation_tolerance: 1e-4,
             max_step_translation: 0.04,
             max_step_rotation: 0.05,
         }
@@ -110,6 +113,12 @@ fn capped(step: Vector3<f64>, opts: &SolverOptions) -> Vector3<f64> {
     step * scale
 }
 
+/// A step below both tolerances.
+fn small(step: Vector3<f64>, opts: &SolverOptions) -> bool {
+    (step.x * step.x + step.y * step.y).sqrt() < opts.translation_tolerance
+        && step.z.abs() < opts.rotation_tolerance
+}
+
 fn moved(p: Pose2, step: Vector3<f64>) -> Pose2 {
     Pose2::new(p.x + step.x, p.y + step.y, p.theta + step.z)
 }
@@ -127,9 +136,7 @@ where
     while iterations < opts.max_iterations && terms.matched > 0 {
         // eq. (3): Δp = −H⁻¹ g (with the absolute, floored Hessian).
         let step = capped(-solve_absolute(&terms.hessian, &terms.gradient), opts);
-        if (step.x * step.x + step.y * step.y).sqrt() < opts.translation_tolerance
-            && step.z.abs() < opts.rotation_tolerance
-        {
+        if small(step, opts) {
             converged = true;
             break;
         }
@@ -137,23 +144,39 @@ where
         let slope = terms.gradient.dot(&step);
         let mut alpha = 1.0;
         let mut accepted = None;
-        for _ in 0..=MAX_HALVINGS {
+        for halving in 0..=MAX_HALVINGS {
             let candidate = moved(pose, step * alpha);
-            let f = -eval(candidate, Order::Value).score;
-            if f <= f0 + ARMIJO * alpha * slope {
-                accepted = Some(candidate);
+            // The full step is evaluated with derivatives: it is usually
+            // accepted, and then the next iteration reuses them.
+            let order = if halving == 0 {
+                Order::Derivatives
+            } else {
+                Order::Value
+            };
+            let trial = eval(candidate, order);
+            if -trial.score <= f0 + ARMIJO * alpha * slope {
+                accepted = Some((candidate, trial, order));
+                break;
+            }
+            if small(step * alpha, opts) {
+                // No decrease anywhere along the step down to the tolerance:
+                // a local optimum of the (piecewise smooth) score at that
+                // resolution.
+                converged = true;
                 break;
             }
             alpha *= 0.5;
         }
-        let Some(next) = accepted else { break };
+        let Some((next, next_terms, order)) = accepted else {
+            break;
+        };
         iterations += 1;
         pose = next;
-        terms = eval(pose, Order::Derivatives);
-        let taken = step * alpha;
-        if (taken.x * taken.x + taken.y * taken.y).sqrt() < opts.translation_tolerance
-            && taken.z.abs() < opts.rotation_tolerance
-        {
+        terms = match order {
+            Order::Derivatives => next_terms,
+            Order::Value => eval(pose, Order::Derivatives),
+        };
+        if small(step * alpha, opts) {
             converged = true;
             break;
         }

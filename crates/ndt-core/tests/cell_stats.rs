@@ -121,7 +121,7 @@ fn overflow_error_names_the_point() {
         .unwrap_err();
     assert_eq!(
         err.to_string(),
-        "points: point 1 at (30000000, 1) m is outside the grid's range of ±21474836.48 m \
+        "points: point 1 at (3e7, 1) m is outside the grid's range of ±21474836.48 m \
          (cell index would overflow)"
     );
 }

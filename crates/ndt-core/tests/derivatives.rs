@@ -50,7 +50,7 @@ fn per_point_gradient_and_hessian_equal_central_differences() {
             rng.random_range(-3.1..3.1),
         ];
         // Choose the scan point so that it lands about 1σ from the mean.
-        let sigma = g.covariance.trace().sqrt();
+        let sigma = g.covariance().trace().sqrt();
         let target =
             g.mean + Vector2::new(rng.random_range(-1.5..1.5), rng.random_range(-1.5..1.5)) * sigma;
         let pose = Pose2 {
@@ -64,7 +64,7 @@ fn per_point_gradient_and_hessian_equal_central_differences() {
         let gr = |q: [f64; 3]| terms_one(xv, &g, q).gradient;
         // The step scales with the distribution's width and the lever arm of θ,
         // so that truncation error stays far below the tolerance.
-        let (_, l2, _) = ndt_core::cell::symmetric_eigen2(&g.covariance);
+        let (_, l2, _) = ndt_core::cell::symmetric_eigen2(&g.covariance());
         let h = 1e-4 * l2.sqrt() / (1.0 + xv.norm());
         let mut g_fd = Vector3::zeros();
         let mut h_fd = Matrix3::zeros();

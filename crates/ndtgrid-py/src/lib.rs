@@ -1,1 +1,23 @@
+//! The thin PyO3 layer of ndtgrid (`ndtgrid._core`): conversion, validation
+//! and error mapping around `ndt-core`; no algorithm lives here.
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod convert;
+mod errors;
+mod grid;
+mod result;
+mod se2;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<grid::PyNdtGrid>()?;
+    m.add_class::<result::PyMatchResult>()?;
+    m.add_function(wrap_pyfunction!(grid::default_match_options, m)?)?;
+    m.add_function(wrap_pyfunction!(se2::compose, m)?)?;
+    m.add_function(wrap_pyfunction!(se2::inverse, m)?)?;
+    m.add_function(wrap_pyfunction!(se2::between, m)?)?;
+    Ok(())
+}

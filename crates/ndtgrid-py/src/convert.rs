@@ -1,0 +1,139 @@
+//! numpy ⇄ core conversion and argument validation (shapes and dtypes; the
+//! core checks values). Arrays that are already C-contiguous float64 are
+//! borrowed, never copied.
+
+use numpy::{PyArray1, PyArray2, PyArrayDescrMethods, PyArrayMethods, PyReadonlyArray2, PyUntypedArray, PyUntypedArrayMethods};
+use ndt_core::nalgebra::Matrix3;
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyAnyMethods;
+
+/// `(N, 2)` float64 points, borrowed from a C-contiguous numpy array.
+pub struct Points<'py> {
+    array: PyReadonlyArray2<'py, f64>,
+}
+
+impl Points<'_> {
+    /// The points as `[x, y]` pairs [m].
+    pub fn as_pairs(&self) -> PyResult<&[[f64; 2]]> {
+        let flat = self
+            .array
+            .as_slice()
+            .map_err(|e| PyValueError::new_err(format!("points: {e}")))?;
+        bytemuck::try_cast_slice(flat)
+            .map_err(|e| PyValueError::new_err(format!("points: cannot view as (N, 2): {e}")))
+    }
+}
+
+fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => format!(
+            "({})",
+            shape
+                .iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// `numpy.asarray(obj)` with a `TypeError` naming `what` when `obj` is not
+/// array-like, and with the dtype checked to be real numbers.
+fn real_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyUntypedArray>> {
+    let py = obj.py();
+    let np = py.import("numpy")?;
+    let arr = np.call_method1("asarray", (obj,)).map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{what}: expected an array-like of real numbers, got {}",
+            obj.get_type().name().map(|n| n.to_string()).unwrap_or_default()
+        ))
+    })?;
+    let arr = arr.cast_into::<PyUntypedArray>().map_err(|_| {
+        PyTypeError::new_err(format!("{what}: expected an array-like of real numbers"))
+    })?;
+    let dtype = arr.dtype();
+    if !matches!(dtype.kind(), b'f' | b'i' | b'u') {
+        return Err(PyTypeError::new_err(format!(
+            "{what}: expected real numbers (float64), got dtype {}",
+            dtype.str().map(|s| s.to_string()).unwrap_or_default()
+        )));
+    }
+    Ok(arr)
+}
+
+/// A C-contiguous float64 copy of `arr` unless it already is one.
+fn as_f64_contiguous<'py>(arr: Bound<'py, PyUntypedArray>) -> PyResult<Bound<'py, PyAny>> {
+    let is_f64 = arr.dtype().is_equiv_to(&numpy::dtype::<f64>(arr.py()));
+    if is_f64 && arr.is_c_contiguous() {
+        return Ok(arr.into_any());
+    }
+    let np = arr.py().import("numpy")?;
+    np.call_method1("ascontiguousarray", (arr, np.getattr("float64")?))
+}
+
+/// Validates and borrows `(N, 2)` points named `what`.
+pub fn points<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Points<'py>> {
+    let arr = real_array(obj, what)?;
+    let shape = arr.shape().to_vec();
+    if shape.len() != 2 || shape[1] != 2 {
+        return Err(PyValueError::new_err(format!(
+            "{what}: expected an array of shape (N, 2), got shape {}",
+            shape_text(&shape)
+        )));
+    }
+    let array = as_f64_contiguous(arr)?
+        .cast_into::<PyArray2<f64>>()
+        .map_err(|e| PyTypeError::new_err(format!("{what}: {e}")))?
+        .readonly();
+    Ok(Points { array })
+}
+
+/// Validates a `[x, y, theta]` pose named `what`.
+pub fn pose(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 3]> {
+    let arr = real_array(obj, what)?;
+    let shape = arr.shape().to_vec();
+    if shape != [3] {
+        return Err(PyValueError::new_err(format!(
+            "{what}: expected 3 values [x, y, theta], got shape {}",
+            shape_text(&shape)
+        )));
+    }
+    let arr = as_f64_contiguous(arr)?
+        .cast_into::<PyArray1<f64>>()
+        .map_err(|e| PyTypeError::new_err(format!("{what}: {e}")))?;
+    let ro = arr.readonly();
+    let s = ro
+        .as_slice()
+        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
+    Ok([s[0], s[1], s[2]])
+}
+
+/// A `(3,)` float64 array.
+pub fn vec3<'py>(py: Python<'py>, v: [f64; 3]) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_slice(py, &v)
+}
+
+/// Row-major copy of a 3×3 matrix.
+pub fn rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
+    [
+        [m[(0, 0)], m[(0, 1)], m[(0, 2)]],
+        [m[(1, 0)], m[(1, 1)], m[(1, 2)]],
+        [m[(2, 0)], m[(2, 1)], m[(2, 2)]],
+    ]
+}
+
+/// A `(3, 3)` float64 array from a row-major matrix.
+pub fn mat3<'py>(py: Python<'py>, m: [[f64; 3]; 3]) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    PyArray1::from_slice(py, m.as_flattened()).reshape([3, 3])
+}
+
+/// A non-negative integer option named `what`.
+pub fn count(what: &str, value: i64) -> PyResult<u32> {
+    u32::try_from(value).map_err(|_| {
+        PyValueError::new_err(format!(
+            "{what}: expected a non-negative integer below 2**32, got {value}"
+        ))
+    })
+}

@@ -1,0 +1,275 @@
+//! `ndtgrid.NdtGrid`: the sparse NDT grid map of §III-B and its matcher.
+//!
+//! Concurrency: the grid sits behind a read-write lock taken with the GIL
+//! released, so many threads can `match` at once while `insert` is exclusive.
+
+use std::sync::RwLock;
+
+use ndt_core::{MatchOptions, NdtGrid, Pose2};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::{count, mat3, points, pose, rows, vec3};
+use crate::errors::{poisoned, to_py};
+use crate::result::PyMatchResult;
+
+/// Sparse, unbounded NDT grid map (see the stub for the documentation).
+#[pyclass(name = "NdtGrid", module = "ndtgrid._core", frozen)]
+pub struct PyNdtGrid {
+    inner: RwLock<NdtGrid>,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn match_options(
+    expansion: f64,
+    neighbor_search: bool,
+    fuse_minority: bool,
+    search_radius: u32,
+    max_iterations: u32,
+    translation_tolerance: f64,
+    rotation_tolerance: f64,
+    max_step_cells: f64,
+    max_step_rotation: f64,
+) -> MatchOptions {
+    MatchOptions {
+        expansion,
+        neighbor_search,
+        search_radius,
+        fuse_minority,
+        max_iterations,
+        translation_tolerance,
+        rotation_tolerance,
+        max_step_cells,
+        max_step_rotation,
+    }
+}
+
+impl PyNdtGrid {
+    fn read<T>(&self, py: Python<'_>, f: impl FnOnce(&NdtGrid) -> T + Send) -> PyResult<T>
+    where
+        T: Send,
+    {
+        py.detach(|| {
+            let grid = self.inner.read().map_err(|_| ())?;
+            Ok(f(&grid))
+        })
+        .map_err(|()| poisoned())
+    }
+}
+
+#[pymethods]
+impl PyNdtGrid {
+    #[new]
+    #[pyo3(signature = (cell_size = 0.02))]
+    fn new(cell_size: f64) -> PyResult<Self> {
+        Ok(Self {
+            inner: RwLock::new(NdtGrid::new(cell_size).map_err(to_py)?),
+        })
+    }
+
+    /// Cell size [m].
+    #[getter]
+    fn cell_size(&self, py: Python<'_>) -> PyResult<f64> {
+        self.read(py, NdtGrid::cell_size)
+    }
+
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.read(py, NdtGrid::len)
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        self.read(py, |g| {
+            format!("NdtGrid(cell_size={}, cells={})", g.cell_size(), g.len())
+        })
+    }
+
+    /// eq. (6): adds scan-frame points seen from `pose`.
+    fn insert(
+        &self,
+        py: Python<'_>,
+        points: &Bound<'_, PyAny>,
+        pose: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        let pts = points_arg(points)?;
+        let pairs = pts.as_pairs()?;
+        let p = crate::convert::pose(pose, "pose")?;
+        py.detach(|| {
+            let mut grid = self.inner.write().map_err(|_| poisoned())?;
+            grid.insert(pairs, Pose2::new(p[0], p[1], p[2]))
+                .map(|_| ())
+                .map_err(to_py)
+        })
+    }
+
+    /// Matches scan-frame points against the map from `guess`.
+    #[pyo3(name = "match", signature = (
+        points, guess, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
+        search_radius = 3, max_iterations = 50, translation_tolerance = 1e-5,
+        rotation_tolerance = 1e-5, max_step_cells = 2.0, max_step_rotation = 0.05
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn match_scan(
+        &self,
+        py: Python<'_>,
+        points: &Bound<'_, PyAny>,
+        guess: &Bound<'_, PyAny>,
+        expansion: f64,
+        neighbor_search: bool,
+        fuse_minority: bool,
+        search_radius: i64,
+        max_iterations: i64,
+        translation_tolerance: f64,
+        rotation_tolerance: f64,
+        max_step_cells: f64,
+        max_step_rotation: f64,
+    ) -> PyResult<PyMatchResult> {
+        let options = match_options(
+            expansion,
+            neighbor_search,
+            fuse_minority,
+            count("search_radius", search_radius)?,
+            count("max_iterations", max_iterations)?,
+            translation_tolerance,
+            rotation_tolerance,
+            max_step_cells,
+            max_step_rotation,
+        );
+        let pts = points_arg(points)?;
+        let pairs = pts.as_pairs()?;
+        let g = pose(guess, "guess")?;
+        let guess = Pose2 {
+            x: g[0],
+            y: g[1],
+            theta: g[2],
+        };
+        self.read(py, |grid| grid.match_scan(pairs, guess, &options))?
+            .map(PyMatchResult::from)
+            .map_err(to_py)
+    }
+
+    /// Score terms of eq. (1) at `pose` without solving.
+    #[pyo3(signature = (
+        points, pose, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
+        search_radius = 3
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn evaluate<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        pose: &Bound<'py, PyAny>,
+        expansion: f64,
+        neighbor_search: bool,
+        fuse_minority: bool,
+        search_radius: i64,
+    ) -> PyResult<(f64, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, usize)> {
+        let defaults = MatchOptions::default();
+        let options = MatchOptions {
+            expansion,
+            neighbor_search,
+            fuse_minority,
+            search_radius: count("search_radius", search_radius)?,
+            ..defaults
+        };
+        let pts = points_arg(points)?;
+        let pairs = pts.as_pairs()?;
+        let p = crate::convert::pose(pose, "pose")?;
+        let at = Pose2 {
+            x: p[0],
+            y: p[1],
+            theta: p[2],
+        };
+        let t = self
+            .read(py, |grid| grid.score_terms(pairs, at, &options))?
+            .map_err(to_py)?;
+        Ok((
+            t.score,
+            vec3(py, [t.gradient.x, t.gradient.y, t.gradient.z]),
+            mat3(py, rows(&t.hessian))?,
+            t.matched,
+        ))
+    }
+
+    /// `(K, 2)` cell centres and `(K,)` point counts, sorted by cell index.
+    fn cells<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<i64>>)> {
+        let (centres, counts) = self.read(py, |g| {
+            let s = g.cell_size();
+            let recs = g.cells();
+            let mut centres = Vec::with_capacity(recs.len() * 2);
+            let mut counts = Vec::with_capacity(recs.len());
+            for r in &recs {
+                let c = r.key.center(s);
+                centres.extend_from_slice(&[c.x, c.y]);
+                counts.push(i64::try_from(r.count).unwrap_or(i64::MAX));
+            }
+            (centres, counts)
+        })?;
+        let k = counts.len();
+        Ok((
+            PyArray1::from_vec(py, centres).reshape([k, 2])?,
+            PyArray1::from_vec(py, counts),
+        ))
+    }
+
+    /// The eq. (6) sums of every cell in map coordinates: `(K, 2)` int64 cell
+    /// indices, `(K,)` counts `M`, `(K, 2)` sums `m`, `(K, 2, 2)` sums `S`.
+    #[allow(clippy::type_complexity)]
+    fn cell_statistics<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(
+        Bound<'py, PyArray2<i64>>,
+        Bound<'py, PyArray1<i64>>,
+        Bound<'py, PyArray2<f64>>,
+        Bound<'py, PyArray3<f64>>,
+    )> {
+        let (keys, counts, sums, scatters) = self.read(py, |g| {
+            let recs = g.cells();
+            let mut keys = Vec::with_capacity(recs.len() * 2);
+            let mut counts = Vec::with_capacity(recs.len());
+            let mut sums = Vec::with_capacity(recs.len() * 2);
+            let mut scatters = Vec::with_capacity(recs.len() * 4);
+            for r in &recs {
+                keys.extend_from_slice(&[i64::from(r.key.ix), i64::from(r.key.iy)]);
+                counts.push(i64::try_from(r.count).unwrap_or(i64::MAX));
+                sums.extend_from_slice(&[r.sum.x, r.sum.y]);
+                let s = &r.scatter;
+                scatters.extend_from_slice(&[s[(0, 0)], s[(0, 1)], s[(1, 0)], s[(1, 1)]]);
+            }
+            (keys, counts, sums, scatters)
+        })?;
+        let k = counts.len();
+        Ok((
+            PyArray1::from_vec(py, keys).reshape([k, 2])?,
+            PyArray1::from_vec(py, counts),
+            PyArray1::from_vec(py, sums).reshape([k, 2])?,
+            PyArray1::from_vec(py, scatters).reshape([k, 2, 2])?,
+        ))
+    }
+}
+
+fn points_arg<'py>(obj: &Bound<'py, PyAny>) -> PyResult<crate::convert::Points<'py>> {
+    points(obj, "points")
+}
+
+/// The core's default match options, so the Python layer and its tests can
+/// check that the documented defaults are the ones in force.
+#[pyfunction]
+pub fn default_match_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let d = MatchOptions::default();
+    let out = PyDict::new(py);
+    out.set_item("expansion", d.expansion)?;
+    out.set_item("neighbor_search", d.neighbor_search)?;
+    out.set_item("fuse_minority", d.fuse_minority)?;
+    out.set_item("search_radius", d.search_radius)?;
+    out.set_item("max_iterations", d.max_iterations)?;
+    out.set_item("translation_tolerance", d.translation_tolerance)?;
+    out.set_item("rotation_tolerance", d.rotation_tolerance)?;
+    out.set_item("max_step_cells", d.max_step_cells)?;
+    out.set_item("max_step_rotation", d.max_step_rotation)?;
+    Ok(out)
+}

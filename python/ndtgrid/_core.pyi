@@ -1,0 +1,225 @@
+"""Type stubs of the compiled core ``ndtgrid._core`` (Rust, PyO3)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+ArrayLike = npt.ArrayLike
+F64Array = npt.NDArray[np.float64]
+I64Array = npt.NDArray[np.int64]
+
+class MatchResult:
+    """Outcome of :meth:`NdtGrid.match`; frozen.
+
+    Attributes
+    ----------
+    pose : ndarray, shape (3,)
+        Best pose ``[x, y, theta]`` (m, m, rad) of the scan in the map frame.
+    converged : bool
+        The Newton step fell below the tolerances (not merely ran out of
+        iterations, lost every point, or failed its line search).
+    iterations : int
+        Newton steps taken.
+    score : float
+        ``E(p)`` of eq. (1) at ``pose``, with the distributions used (expanded
+        by ``k``, fused, neighbour-paired).
+    num_matched : int
+        Points that had a reference distribution at ``pose``.
+    hessian : ndarray, shape (3, 3)
+        Hessian of ``-E`` at ``pose`` in the order ``(x, y, theta)``.
+    covariance : ndarray, shape (3, 3)
+        Pose covariance estimate ``H^-1`` (Laplace approximation treating ``E``
+        as a log-likelihood). Eigenvalues of ``H`` below ``1e-9 * max|lambda|``
+        (directions the scan does not constrain) are floored, giving very large
+        but finite variances there.
+    """
+
+    @property
+    def pose(self) -> F64Array: ...
+    @property
+    def converged(self) -> bool: ...
+    @property
+    def iterations(self) -> int: ...
+    @property
+    def score(self) -> float: ...
+    @property
+    def num_matched(self) -> int: ...
+    @property
+    def hessian(self) -> F64Array: ...
+    @property
+    def covariance(self) -> F64Array: ...
+
+class NdtGrid:
+    """Sparse, unbounded NDT grid map (paper §III-B).
+
+    Each cell keeps only the sums of eq. (6): the point count ``M``, the sum
+    ``m`` and the outer-product sum ``S``; never the points. Memory grows with
+    the mapped area, not with the number of scans.
+
+    Parameters
+    ----------
+    cell_size : float, default 0.02
+        Side of the square cells [m] (the paper: 2 cm).
+
+    Raises
+    ------
+    ValueError
+        If ``cell_size`` is not a finite number > 0.
+
+    Notes
+    -----
+    Thread safety: any number of threads may call :meth:`match`,
+    :meth:`evaluate`, :meth:`cells` at once (the GIL is released while they
+    run); :meth:`insert` waits for them and runs alone. Every method either
+    succeeds or leaves the map unchanged.
+    """
+
+    def __init__(self, cell_size: float = 0.02) -> None: ...
+    @property
+    def cell_size(self) -> float:
+        """Cell size [m]."""
+    def __len__(self) -> int:
+        """Number of cells holding at least one point."""
+    def insert(self, points: ArrayLike, pose: ArrayLike) -> None:
+        """Add a scan to the map (eq. 6).
+
+        Parameters
+        ----------
+        points : array_like, shape (N, 2)
+            Scan-frame points [m]; float64 C-contiguous arrays are used without
+            a copy, other real dtypes are converted. ``N = 0`` is a no-op.
+        pose : array_like, shape (3,)
+            ``[x, y, theta]`` (m, m, rad) of the scan in the map frame.
+
+        Raises
+        ------
+        TypeError
+            If an argument is not array-like or holds non-real numbers.
+        ValueError
+            On a wrong shape, a NaN or infinite value, or a point whose cell
+            index would overflow (``|coordinate| >= 2**30 * cell_size``). The
+            map is unchanged after any error.
+        """
+    def match(
+        self,
+        points: ArrayLike,
+        guess: ArrayLike,
+        *,
+        expansion: float = 10.0,
+        neighbor_search: bool = True,
+        fuse_minority: bool = True,
+        search_radius: int = 3,
+        max_iterations: int = 50,
+        translation_tolerance: float = 1e-5,
+        rotation_tolerance: float = 1e-5,
+        max_step_cells: float = 2.0,
+        max_step_rotation: float = 0.05,
+    ) -> MatchResult:
+        """Match a scan against the map by Newton's method on eq. (1).
+
+        The defaults are the paper's method (§IV-A). The original NDT of Biber
+        & Strasser on the same grid is ``expansion=1.0, neighbor_search=False,
+        fuse_minority=False``.
+
+        Parameters
+        ----------
+        points : array_like, shape (N, 2)
+            Scan-frame points [m], N >= 1.
+        guess : array_like, shape (3,)
+            Initial pose ``[x, y, theta]`` (m, m, rad).
+        expansion : float, default 10.0
+            ``k`` of eq. (8): both covariance eigenvalues are multiplied by it.
+        neighbor_search : bool, default True
+            §IV-A(1): a point whose own cell has no distribution is paired with
+            the distribution whose mean is nearest to it among the first ring of
+            cells (Chebyshev distance 1, 2, ..., ``search_radius``) that holds any.
+        fuse_minority : bool, default True
+            §IV-A(3): a cell with fewer than 3 points takes the distribution of
+            the summed eq. (6) terms of itself and its 8 neighbours.
+        search_radius : int, default 3
+            Neighbour-search radius [cells], at most 1000.
+        max_iterations : int, default 50
+            Newton steps at most.
+        translation_tolerance, rotation_tolerance : float, default 1e-5
+            Convergence thresholds on the step [m], [rad].
+        max_step_cells : float, default 2.0
+            Largest translation per Newton step [cells]; keeps the solver inside
+            the narrow basin of a fine grid.
+        max_step_rotation : float, default 0.05
+            Largest rotation per Newton step [rad].
+
+        Returns
+        -------
+        MatchResult
+            Not converging is a result (``converged=False``), not an exception.
+
+        Raises
+        ------
+        TypeError, ValueError
+            As for :meth:`insert`; also for an empty scan, a guess that is not 3
+            finite values, or an option out of range.
+        """
+    def evaluate(
+        self,
+        points: ArrayLike,
+        pose: ArrayLike,
+        *,
+        expansion: float = 10.0,
+        neighbor_search: bool = True,
+        fuse_minority: bool = True,
+        search_radius: int = 3,
+    ) -> tuple[float, F64Array, F64Array, int]:
+        """Score terms at ``pose`` without solving.
+
+        Returns
+        -------
+        score : float
+            ``E(p)`` of eq. (1).
+        gradient : ndarray, shape (3,)
+            Gradient of ``-E`` (eq. 4).
+        hessian : ndarray, shape (3, 3)
+            Hessian of ``-E`` (eq. 5).
+        num_matched : int
+            Points with a reference distribution.
+        """
+    def cells(self) -> tuple[F64Array, I64Array]:
+        """Occupied cells, sorted by cell index.
+
+        Returns
+        -------
+        centers : ndarray, shape (K, 2)
+            Cell centres [m].
+        counts : ndarray, shape (K,)
+            Point counts ``M``.
+        """
+    def cell_statistics(self) -> tuple[I64Array, I64Array, F64Array, F64Array]:
+        """The eq. (6) sums of every cell in map coordinates, sorted by index.
+
+        Returns
+        -------
+        indices : ndarray, shape (K, 2)
+            Integer cell indices ``floor(x / cell_size)``.
+        counts : ndarray, shape (K,)
+            ``M``.
+        sums : ndarray, shape (K, 2)
+            ``m = sum x`` [m].
+        scatters : ndarray, shape (K, 2, 2)
+            ``S = sum x x^T`` [m^2].
+        """
+
+def default_match_options() -> dict[str, Any]:
+    """The core's defaults for :meth:`NdtGrid.match`."""
+
+def compose(a: ArrayLike, b: ArrayLike) -> F64Array:
+    """``a o b``: pose ``b`` (given in frame ``a``) in ``a``'s parent frame, shape (3,)."""
+
+def inverse(p: ArrayLike) -> F64Array:
+    """The inverse motion of ``p``, shape (3,)."""
+
+def between(a: ArrayLike, b: ArrayLike) -> F64Array:
+    """``a^-1 o b``: the motion from ``a`` to ``b`` in ``a``'s frame, shape (3,)."""
