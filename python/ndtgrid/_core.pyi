@@ -115,8 +115,8 @@ class NdtGrid:
         fuse_minority: bool = True,
         search_radius: int = 3,
         max_iterations: int = 50,
-        translation_tolerance: float = 1e-5,
-        rotation_tolerance: float = 1e-5,
+        translation_tolerance: float = 1e-4,
+        rotation_tolerance: float = 1e-4,
         max_step_cells: float = 2.0,
         max_step_rotation: float = 0.05,
     ) -> MatchResult:
@@ -145,7 +145,7 @@ class NdtGrid:
             Neighbour-search radius [cells], at most 1000.
         max_iterations : int, default 50
             Newton steps at most.
-        translation_tolerance, rotation_tolerance : float, default 1e-5
+        translation_tolerance, rotation_tolerance : float, default 1e-4
             Convergence thresholds on the step [m], [rad].
         max_step_cells : float, default 2.0
             Largest translation per Newton step [cells]; keeps the solver inside
@@ -223,3 +223,35 @@ def inverse(p: ArrayLike) -> F64Array:
 
 def between(a: ArrayLike, b: ArrayLike) -> F64Array:
     """``a^-1 o b``: the motion from ``a`` to ``b`` in ``a``'s frame, shape (3,)."""
+
+def ranges_to_points(
+    ranges: ArrayLike,
+    angles: ArrayLike,
+    *,
+    min_range: float = 0.0,
+    max_range: float = ...,
+) -> F64Array:
+    """Scan-frame points of the valid beams of a laser scan.
+
+    Parameters
+    ----------
+    ranges : array_like, shape (B,)
+        Ranges [m]. Beams with a range that is 0, NaN, infinite, below
+        ``min_range`` or at or above ``max_range`` are skipped.
+    angles : array_like, shape (B,)
+        Beam angles in the sensor frame [rad]; must be finite.
+    min_range : float, default 0.0
+        Smallest valid range [m].
+    max_range : float, default inf
+        Ranges at or above it mean "no return" [m].
+
+    Returns
+    -------
+    ndarray, shape (N, 2)
+        ``(r cos a, r sin a)`` of the N valid beams, in beam order.
+
+    Raises
+    ------
+    ValueError
+        If the lengths differ, an angle is not finite or the limits are invalid.
+    """

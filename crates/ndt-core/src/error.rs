@@ -42,6 +42,16 @@ pub enum NdtError {
         /// Which argument was empty.
         what: &'static str,
     },
+    /// Two inputs that must have the same length do not.
+    #[error("{what}: expected {expected} values (one per range), got {got}")]
+    LengthMismatch {
+        /// The argument whose length is wrong.
+        what: &'static str,
+        /// The length it must have.
+        expected: usize,
+        /// The length it has.
+        got: usize,
+    },
     /// An option outside its admissible range.
     #[error("{name}: expected {expected}, got {value}")]
     InvalidOption {

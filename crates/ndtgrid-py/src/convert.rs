@@ -2,8 +2,11 @@
 //! core checks values). Arrays that are already C-contiguous float64 are
 //! borrowed, never copied.
 
-use numpy::{PyArray1, PyArray2, PyArrayDescrMethods, PyArrayMethods, PyReadonlyArray2, PyUntypedArray, PyUntypedArrayMethods};
 use ndt_core::nalgebra::Matrix3;
+use numpy::{
+    PyArray1, PyArray2, PyArrayDescrMethods, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyUntypedArray, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyAnyMethods;
@@ -47,7 +50,10 @@ fn real_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, P
     let arr = np.call_method1("asarray", (obj,)).map_err(|_| {
         PyTypeError::new_err(format!(
             "{what}: expected an array-like of real numbers, got {}",
-            obj.get_type().name().map(|n| n.to_string()).unwrap_or_default()
+            obj.get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
         ))
     })?;
     let arr = arr.cast_into::<PyUntypedArray>().map_err(|_| {
@@ -88,6 +94,37 @@ pub fn points<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Points<'py>>
         .map_err(|e| PyTypeError::new_err(format!("{what}: {e}")))?
         .readonly();
     Ok(Points { array })
+}
+
+/// A 1-D float64 array, borrowed from a C-contiguous numpy array.
+pub struct Vector<'py> {
+    array: PyReadonlyArray1<'py, f64>,
+}
+
+impl Vector<'_> {
+    /// The values.
+    pub fn as_slice(&self) -> PyResult<&[f64]> {
+        self.array
+            .as_slice()
+            .map_err(|e| PyValueError::new_err(e.to_string()))
+    }
+}
+
+/// Validates and borrows a 1-D array named `what`.
+pub fn vector<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Vector<'py>> {
+    let arr = real_array(obj, what)?;
+    let shape = arr.shape().to_vec();
+    if shape.len() != 1 {
+        return Err(PyValueError::new_err(format!(
+            "{what}: expected a 1-D array, got shape {}",
+            shape_text(&shape)
+        )));
+    }
+    let array = as_f64_contiguous(arr)?
+        .cast_into::<PyArray1<f64>>()
+        .map_err(|e| PyTypeError::new_err(format!("{what}: {e}")))?
+        .readonly();
+    Ok(Vector { array })
 }
 
 /// Validates a `[x, y, theta]` pose named `what`.

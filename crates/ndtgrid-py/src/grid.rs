@@ -105,8 +105,8 @@ impl PyNdtGrid {
     /// Matches scan-frame points against the map from `guess`.
     #[pyo3(name = "match", signature = (
         points, guess, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
-        search_radius = 3, max_iterations = 50, translation_tolerance = 1e-5,
-        rotation_tolerance = 1e-5, max_step_cells = 2.0, max_step_rotation = 0.05
+        search_radius = 3, max_iterations = 50, translation_tolerance = 1e-4,
+        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05
     ))]
     #[allow(clippy::too_many_arguments)]
     fn match_scan(
@@ -163,7 +163,12 @@ impl PyNdtGrid {
         neighbor_search: bool,
         fuse_minority: bool,
         search_radius: i64,
-    ) -> PyResult<(f64, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, usize)> {
+    ) -> PyResult<(
+        f64,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray2<f64>>,
+        usize,
+    )> {
         let defaults = MatchOptions::default();
         let options = MatchOptions {
             expansion,

@@ -5,6 +5,7 @@
 mod convert;
 mod errors;
 mod grid;
+mod ranges;
 mod result;
 mod se2;
 
@@ -16,6 +17,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<grid::PyNdtGrid>()?;
     m.add_class::<result::PyMatchResult>()?;
     m.add_function(wrap_pyfunction!(grid::default_match_options, m)?)?;
+    m.add_function(wrap_pyfunction!(ranges::ranges_to_points, m)?)?;
     m.add_function(wrap_pyfunction!(se2::compose, m)?)?;
     m.add_function(wrap_pyfunction!(se2::inverse, m)?)?;
     m.add_function(wrap_pyfunction!(se2::between, m)?)?;

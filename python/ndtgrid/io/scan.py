@@ -136,6 +136,35 @@ class Scan:
         """Number of beams ``B``."""
         return int(self.ranges.shape[0])
 
+    def points(
+        self, *, min_range: float = 0.0, max_range: float | None = None
+    ) -> npt.NDArray[np.float64]:
+        """Scan-frame points of the valid beams.
+
+        Parameters
+        ----------
+        min_range : float, default 0.0
+            Smallest valid range [m].
+        max_range : float, optional
+            Ranges at or above it mean "no return" [m]. Defaults to the
+            message's ``max_range`` when it has one, else no limit (0, NaN and
+            infinite ranges are always skipped).
+
+        Returns
+        -------
+        ndarray, shape (N, 2)
+            ``(r cos a, r sin a)`` of the N valid beams [m].
+        """
+        from ndtgrid._core import ranges_to_points
+
+        limit = max_range if max_range is not None else self.max_range
+        return ranges_to_points(
+            self.ranges,
+            self.angles,
+            min_range=min_range,
+            max_range=math.inf if limit is None else limit,
+        )
+
     def __repr__(self) -> str:
         if self.n_beams:
             span = f"[{self.angles[0]:.4f} .. {self.angles[-1]:.4f}] rad"
