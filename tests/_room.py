@@ -14,17 +14,27 @@ F64 = npt.NDArray[np.float64]
 #: Walls ``(x0, y0, x1, y1)`` [m]: a 6 m x 4 m room, a box, a pillar, a diagonal.
 WALLS = np.array(
     [
-        [-3, -2, 3, -2], [3, -2, 3, 2], [3, 2, -3, 2], [-3, 2, -3, -2], [1, 0.5, 2, 1.5],
-        [-1.8, 0.5, -1.2, 0.5], [-1.2, 0.5, -1.2, 1.1], [-1.2, 1.1, -1.8, 1.1],
-        [-1.8, 1.1, -1.8, 0.5], [0.35, -1.35, 0.65, -1.35], [0.65, -1.35, 0.65, -1.05],
-        [0.65, -1.05, 0.35, -1.05], [0.35, -1.05, 0.35, -1.35],
+        [-3, -2, 3, -2],
+        [3, -2, 3, 2],
+        [3, 2, -3, 2],
+        [-3, 2, -3, -2],
+        [1, 0.5, 2, 1.5],
+        [-1.8, 0.5, -1.2, 0.5],
+        [-1.2, 0.5, -1.2, 1.1],
+        [-1.2, 1.1, -1.8, 1.1],
+        [-1.8, 1.1, -1.8, 0.5],
+        [0.35, -1.35, 0.65, -1.35],
+        [0.65, -1.35, 0.65, -1.05],
+        [0.65, -1.05, 0.35, -1.05],
+        [0.35, -1.05, 0.35, -1.35],
     ],
     dtype=float,
 )
 
 
-def scan(pose: npt.ArrayLike, beams: int = 683, fov_deg: float = 240.0,
-         noise: float = 0.0, seed: int = 0) -> F64:
+def scan(
+    pose: npt.ArrayLike, beams: int = 683, fov_deg: float = 240.0, noise: float = 0.0, seed: int = 0
+) -> F64:
     """Scan-frame points of a laser at ``pose`` [x, y, theta] in the room."""
     x, y, th = np.asarray(pose, dtype=float)
     a = np.linspace(-np.radians(fov_deg) / 2, np.radians(fov_deg) / 2, beams)

@@ -40,11 +40,15 @@ def test_api_names_and_shapes() -> None:
     assert isinstance(res.converged, bool) and isinstance(res.iterations, int)
     assert isinstance(res.score, float) and isinstance(res.num_matched, int)
     assert 0 < res.num_matched <= len(pts)
-    original = grid.match(pts, [0.0, 0.0, 0.0], expansion=1.0, neighbor_search=False,
-                          fuse_minority=False)
+    original = grid.match(
+        pts, [0.0, 0.0, 0.0], expansion=1.0, neighbor_search=False, fuse_minority=False
+    )
     assert original.num_matched > 0
-    assert re.fullmatch(r"MatchResult\(pose=\[.*\], converged=(True|False), iterations=\d+, "
-                        r"score=[\d.]+, num_matched=\d+\)", repr(res))
+    assert re.fullmatch(
+        r"MatchResult\(pose=\[.*\], converged=(True|False), iterations=\d+, "
+        r"score=[\d.]+, num_matched=\d+\)",
+        repr(res),
+    )
     assert repr(grid) == f"NdtGrid(cell_size=0.02, cells={len(grid)})"
 
 
@@ -95,7 +99,7 @@ def test_synthetic_scan_recovered_to_a_millimetre() -> None:
 def test_covariance_is_inverse_hessian_at_a_well_constrained_optimum() -> None:
     grid = room_map()
     truth = np.array([0.12, -0.08, 0.2])
-    res = grid.match(scan(truth, seed=99), truth + [0.01, 0.01, 0.005])
+    res = grid.match(scan(truth, seed=99), truth + np.array([0.01, 0.01, 0.005]))
     assert np.all(np.linalg.eigvalsh(res.hessian) > 0)
     np.testing.assert_allclose(res.covariance @ res.hessian, np.eye(3), atol=1e-8)
 
@@ -104,7 +108,7 @@ def test_non_contiguous_and_other_real_dtypes_give_the_same_result() -> None:
     grid = room_map()
     truth = np.array([0.12, -0.08, 0.2])
     pts = scan(truth, seed=99)
-    guess = truth + [0.02, -0.01, 0.01]
+    guess = truth + np.array([0.02, -0.01, 0.01])
     ref = grid.match(pts, guess).pose
     wide = np.zeros((len(pts), 4))
     wide[:, ::2] = pts
@@ -152,15 +156,25 @@ def test_documented_defaults_are_the_core_defaults() -> None:
     binding = _signature_defaults(text)
     stub = Path(ndtgrid.__file__).with_name("_core.pyi").read_text()
     tree = ast.parse(stub)
-    fn = next(n for c in tree.body if isinstance(c, ast.ClassDef) and c.name == "NdtGrid"
-              for n in c.body if isinstance(n, ast.FunctionDef) and n.name == "match")
-    stub_defaults = {a.arg: ast.literal_eval(d) for a, d in
-                     zip(fn.args.kwonlyargs, fn.args.kw_defaults) if d is not None}
+    fn = next(
+        n
+        for c in tree.body
+        if isinstance(c, ast.ClassDef) and c.name == "NdtGrid"
+        for n in c.body
+        if isinstance(n, ast.FunctionDef) and n.name == "match"
+    )
+    stub_defaults = {
+        a.arg: ast.literal_eval(d)
+        for a, d in zip(fn.args.kwonlyargs, fn.args.kw_defaults)
+        if d is not None
+    }
     assert set(core) == set(stub_defaults) == set(binding)
     for name, value in core.items():
         assert stub_defaults[name] == value, name
-        assert ast.literal_eval(binding[name].replace("true", "True").replace(
-            "false", "False")) == value, name
+        assert (
+            ast.literal_eval(binding[name].replace("true", "True").replace("false", "False"))
+            == value
+        ), name
 
 
 def test_se2_helpers_round_trip() -> None:

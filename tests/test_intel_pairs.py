@@ -26,7 +26,8 @@ MAX_RANGE = 40.0
 def pairs() -> list[ndtgrid.evaluation.ScanPair]:
     log = require_real("radish-gfs-corrected/intel-corrected.log.gz")
     index = read_benchmark_index(
-        require_real("benchmark-scans-split/intel__intel-corrected__index.csv"))
+        require_real("benchmark-scans-split/intel__intel-corrected__index.csv")
+    )
     scans = list(read_carmen(log))
     out = list(corrected_pairs(scans, index, max_range=MAX_RANGE))
     return out[:N_PAIRS]

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import ast
 import csv
 import dataclasses
 import gzip
@@ -12,8 +11,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from ._data import require_real
+
 from ndtgrid.io import OdomRecord, Scan, iter_carmen_messages, read_carmen
+
+from ._data import require_real
 
 INTEL = "radish-gfs-corrected/intel-corrected.log.gz"
 INTEL_INDEX = "benchmark-scans-split/intel__intel-corrected__index.csv"
@@ -407,11 +408,19 @@ def test_scan_repr_shows_shapes_not_arrays() -> None:
 def test_scan_points_skip_invalid_ranges() -> None:
     angles = np.array([0.0, 0.5, 1.0, 1.5, 2.0, 2.5])
     ranges = np.array([1.0, 0.0, np.nan, np.inf, 4.0, 2.0])
-    scan = Scan(timestamp=0.0, ranges=ranges, angles=angles, odom=None, laser_pose=None,
-                max_range=4.0, source="FLASER", line=1)
+    scan = Scan(
+        timestamp=0.0,
+        ranges=ranges,
+        angles=angles,
+        odom=None,
+        laser_pose=None,
+        max_range=4.0,
+        source="FLASER",
+        line=1,
+    )
     expected = np.array([[np.cos(0.0), 0.0], [2 * np.cos(2.5), 2 * np.sin(2.5)]])
     np.testing.assert_allclose(scan.points(), expected, atol=1e-15)
     assert scan.points(max_range=10.0).shape == (3, 2)
     assert scan.points(min_range=1.5, max_range=10.0).shape == (2, 2)
-    with pytest.raises(ValueError, match="^max_range: expected a range > min_range, got 0.5$"):
+    with pytest.raises(ValueError, match=r"^max_range: expected a range > min_range, got 0\.5$"):
         scan.points(min_range=1.0, max_range=0.5)

@@ -97,8 +97,9 @@ def corrected_pairs(
         If ``scans`` and ``index`` differ in length or ``gap < 1``.
     """
     if len(scans) != len(index):
-        raise ValueError(f"scans: expected {len(index)} scans (one per index row), "
-                         f"got {len(scans)}")
+        raise ValueError(
+            f"scans: expected {len(index)} scans (one per index row), got {len(scans)}"
+        )
     if gap < 1:
         raise ValueError(f"gap: expected an integer >= 1, got {gap}")
     for i in range(len(scans) - gap):

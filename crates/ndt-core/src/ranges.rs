@@ -29,7 +29,7 @@ pub fn points_from_ranges(
             value: min_range,
         });
     }
-    if !(max_range > min_range) {
+    if max_range.is_nan() || max_range <= min_range {
         return Err(NdtError::InvalidOption {
             name: "max_range",
             expected: "a range > min_range",

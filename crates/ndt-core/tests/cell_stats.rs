@@ -47,8 +47,8 @@ fn check(cell: f64, centre: [f64; 2], spread: f64, seed: u64) {
         assert_eq!((i64::from(rec.key.ix), i64::from(rec.key.iy)), (*kx, *ky));
         assert_eq!(rec.count, *n);
         let scale = 1.0 + centre[0].abs().max(centre[1].abs());
-        for i in 0..2 {
-            assert!((rec.sum[i] - m[i]).abs() <= 1e-9 * scale * *n as f64);
+        for (i, mi) in m.iter().enumerate() {
+            assert!((rec.sum[i] - mi).abs() <= 1e-9 * scale * *n as f64);
         }
         for (i, v) in s.iter().enumerate() {
             let g = rec.scatter[(i / 2, i % 2)];

@@ -14,6 +14,16 @@ use crate::convert::{count, mat3, points, pose, rows, vec3};
 use crate::errors::{poisoned, to_py};
 use crate::result::PyMatchResult;
 
+/// `(score, gradient, hessian, num_matched)` as returned by `evaluate`.
+type Terms<'py> = (
+    f64,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    usize,
+);
+/// `(centres, counts)` as returned by `cells`.
+type Cells<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<i64>>);
+
 /// Sparse, unbounded NDT grid map (see the stub for the documentation).
 #[pyclass(name = "NdtGrid", module = "ndtgrid._core", frozen)]
 pub struct PyNdtGrid {
@@ -163,12 +173,7 @@ impl PyNdtGrid {
         neighbor_search: bool,
         fuse_minority: bool,
         search_radius: i64,
-    ) -> PyResult<(
-        f64,
-        Bound<'py, PyArray1<f64>>,
-        Bound<'py, PyArray2<f64>>,
-        usize,
-    )> {
+    ) -> PyResult<Terms<'py>> {
         let defaults = MatchOptions::default();
         let options = MatchOptions {
             expansion,
@@ -197,10 +202,7 @@ impl PyNdtGrid {
     }
 
     /// `(K, 2)` cell centres and `(K,)` point counts, sorted by cell index.
-    fn cells<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<i64>>)> {
+    fn cells<'py>(&self, py: Python<'py>) -> PyResult<Cells<'py>> {
         let (centres, counts) = self.read(py, |g| {
             let s = g.cell_size();
             let recs = g.cells();

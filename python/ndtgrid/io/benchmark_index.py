@@ -19,8 +19,16 @@ import numpy.typing as npt
 __all__ = ["BenchmarkIndex", "read_benchmark_index"]
 
 _COLUMNS = (
-    "gfs_scan", "raw_scan", "ipc_ts", "logger_ts", "corr_x", "corr_y", "corr_theta",
-    "raw_odo_x", "raw_odo_y", "raw_odo_theta",
+    "gfs_scan",
+    "raw_scan",
+    "ipc_ts",
+    "logger_ts",
+    "corr_x",
+    "corr_y",
+    "corr_theta",
+    "raw_odo_x",
+    "raw_odo_y",
+    "raw_odo_theta",
 )
 
 
