@@ -23,6 +23,7 @@ pub struct DistOptions {
 #[derive(Debug, Clone)]
 pub struct Distributions {
     options: DistOptions,
+    level: usize,
     cell_size: f64,
     map: FxHashMap<CellKey, Gaussian>,
 }
@@ -32,6 +33,7 @@ impl Distributions {
     pub fn build(
         cells: &FxHashMap<CellKey, CellStats>,
         cell_size: f64,
+        level: usize,
         options: DistOptions,
     ) -> Self {
         let mut map = FxHashMap::default();
@@ -43,6 +45,7 @@ impl Distributions {
         }
         Self {
             options,
+            level,
             cell_size,
             map,
         }
@@ -87,6 +90,11 @@ impl Distributions {
     /// The options these distributions were built with.
     pub fn options(&self) -> DistOptions {
         self.options
+    }
+
+    /// The pyramid level these distributions belong to (0 = fine).
+    pub fn level(&self) -> usize {
+        self.level
     }
 
     /// Cell size [m].

@@ -4,17 +4,22 @@
 use std::sync::{Arc, Mutex, MutexGuard};
 
 use nalgebra::{Matrix2, Vector2};
-use rustc_hash::{FxHashMap, FxHashSet};
+use rustc_hash::FxHashMap;
 
 use crate::cell::CellStats;
 use crate::distributions::{DistOptions, Distributions};
 use crate::error::{check_finite, NdtError, Result};
 use crate::key::{CellKey, MAX_INDEX};
+use crate::pyramid::{Level, Pyramid, MAX_LEVELS};
 use crate::se2::Pose2;
 
-/// How many prepared distribution sets (one per distinct expansion/fusion
-/// setting) a grid keeps between calls.
-const PREPARED_CAPACITY: usize = 4;
+/// How many prepared distribution sets (one per pyramid level and distinct
+/// expansion/fusion setting) a grid keeps between calls.
+const PREPARED_CAPACITY: usize = 24;
+
+/// Pyramid levels of a new grid: the fine cells and four coarser levels
+/// (with 2 cm cells: 2, 4, 8, 16 and 32 cm).
+pub const DEFAULT_LEVELS: usize = 5;
 
 /// One cell as returned to callers: index and the paper's sums in map
 /// coordinates (`m = Σx`, `S = Σ x xᵀ`).
@@ -39,7 +44,7 @@ pub struct CellRecord {
 pub struct NdtGrid {
     cell_size: f64,
     inv_cell_size: f64,
-    cells: FxHashMap<CellKey, CellStats>,
+    pyramid: Pyramid,
     prepared: Mutex<Vec<Arc<Distributions>>>,
 }
 
@@ -48,7 +53,7 @@ impl Clone for NdtGrid {
         Self {
             cell_size: self.cell_size,
             inv_cell_size: self.inv_cell_size,
-            cells: self.cells.clone(),
+            pyramid: self.pyramid.clone(),
             // Deep copies, so that the clone's inserts update its own
             // distributions in place instead of copying them on first write.
             prepared: Mutex::new(
@@ -62,8 +67,15 @@ impl Clone for NdtGrid {
 }
 
 impl NdtGrid {
-    /// An empty grid with square cells of `cell_size` metres (the paper: 0.02).
+    /// An empty grid with square cells of `cell_size` metres (the paper: 0.02)
+    /// and [`DEFAULT_LEVELS`] pyramid levels.
     pub fn new(cell_size: f64) -> Result<Self> {
+        Self::with_levels(cell_size, DEFAULT_LEVELS)
+    }
+
+    /// An empty grid with `levels` pyramid levels (1 = the fine grid only, at
+    /// most [`MAX_LEVELS`]); level `l` has cells of `cell_size · 2^l`.
+    pub fn with_levels(cell_size: f64, levels: usize) -> Result<Self> {
         if !(cell_size.is_finite() && cell_size > 0.0) {
             return Err(NdtError::InvalidOption {
                 name: "cell_size",
@@ -71,12 +83,33 @@ impl NdtGrid {
                 value: cell_size,
             });
         }
+        if levels == 0 || levels > MAX_LEVELS {
+            return Err(NdtError::InvalidOption {
+                name: "levels",
+                expected: "between 1 and 12 pyramid levels",
+                value: levels as f64,
+            });
+        }
         Ok(Self {
             cell_size,
             inv_cell_size: 1.0 / cell_size,
-            cells: FxHashMap::default(),
+            pyramid: Pyramid::new(cell_size, levels),
             prepared: Mutex::new(Vec::new()),
         })
+    }
+
+    /// Number of pyramid levels (fine level included).
+    pub fn levels(&self) -> usize {
+        self.pyramid.len()
+    }
+
+    /// Pyramid level `l` (0 = fine): its cell size and sums.
+    pub fn level(&self, l: usize) -> Option<&Level> {
+        self.pyramid.level(l)
+    }
+
+    fn fine(&self) -> &FxHashMap<CellKey, CellStats> {
+        self.pyramid.fine().cells()
     }
 
     /// Cell size [m].
@@ -91,12 +124,12 @@ impl NdtGrid {
 
     /// Number of cells holding at least one point.
     pub fn len(&self) -> usize {
-        self.cells.len()
+        self.fine().len()
     }
 
     /// `true` when no point was ever inserted.
     pub fn is_empty(&self) -> bool {
-        self.cells.is_empty()
+        self.fine().is_empty()
     }
 
     /// Largest |map coordinate| a point may have [m].
@@ -106,14 +139,14 @@ impl NdtGrid {
 
     /// The sums of one cell about its centre, if it holds points.
     pub fn stats(&self, key: CellKey) -> Option<&CellStats> {
-        self.cells.get(&key)
+        self.fine().get(&key)
     }
 
     /// Every occupied cell with its eq. (6) sums in map coordinates, sorted by
     /// key (`ix`, then `iy`) so the order is deterministic.
     pub fn cells(&self) -> Vec<CellRecord> {
         let mut out: Vec<CellRecord> = self
-            .cells
+            .fine()
             .iter()
             .map(|(&key, s)| {
                 // Back from "about the centre c" to "about the origin": shift by −c.
@@ -151,37 +184,44 @@ impl NdtGrid {
             })?;
             staged.push((key, w));
         }
-        let mut seen = FxHashSet::default();
-        let mut touched = Vec::new();
-        for (key, w) in staged {
-            if seen.insert(key) {
-                touched.push(key);
-            }
-            let c = key.center(self.cell_size);
-            self.cells.entry(key).or_default().add_point(w - c);
-        }
-        let cell_size = self.cell_size;
-        let cells = &self.cells;
+        let touched = self.pyramid.add(&staged);
         let prepared = self.prepared.get_mut().unwrap_or_else(|e| e.into_inner());
         for dist in prepared.iter_mut() {
-            Arc::make_mut(dist).update(cells, cell_size, &touched);
+            let l = dist.level();
+            if let (Some(level), Some(keys)) = (self.pyramid.level(l), touched.get(l)) {
+                Arc::make_mut(dist).update(level.cells(), level.cell_size(), keys);
+            }
         }
-        Ok(touched)
+        Ok(touched.into_iter().next().unwrap_or_default())
     }
 
-    /// The distributions for `options`, built on first use and then kept up to
-    /// date by [`NdtGrid::insert`].
-    pub(crate) fn distributions(&self, options: DistOptions) -> Arc<Distributions> {
+    /// The distributions of pyramid level `level` for `options`, built on
+    /// first use and then kept up to date by [`NdtGrid::insert`]. `None` for a
+    /// level the grid does not have.
+    pub(crate) fn distributions(
+        &self,
+        level: usize,
+        options: DistOptions,
+    ) -> Option<Arc<Distributions>> {
+        let lv = self.pyramid.level(level)?;
         let mut prepared = self.lock_prepared();
-        if let Some(found) = prepared.iter().find(|d| d.options() == options) {
-            return Arc::clone(found);
+        if let Some(found) = prepared
+            .iter()
+            .find(|d| d.level() == level && d.options() == options)
+        {
+            return Some(Arc::clone(found));
         }
-        let built = Arc::new(Distributions::build(&self.cells, self.cell_size, options));
+        let built = Arc::new(Distributions::build(
+            lv.cells(),
+            lv.cell_size(),
+            level,
+            options,
+        ));
         if prepared.len() >= PREPARED_CAPACITY {
             prepared.remove(0);
         }
         prepared.push(Arc::clone(&built));
-        built
+        Some(built)
     }
 
     fn lock_prepared(&self) -> MutexGuard<'_, Vec<Arc<Distributions>>> {

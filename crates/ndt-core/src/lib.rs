@@ -21,6 +21,7 @@ pub mod grid;
 pub mod key;
 pub mod matcher;
 pub mod neighbor;
+pub mod pyramid;
 pub mod ranges;
 pub mod score;
 pub mod se2;

@@ -1,5 +1,7 @@
 //! NDT scan matching against an [`NdtGrid`] (§III-A with the fixes of §IV-A).
 
+use std::sync::Arc;
+
 use nalgebra::{Matrix3, Vector2};
 
 use crate::cell::Gaussian;
@@ -41,6 +43,12 @@ pub struct MatchOptions {
     pub max_step_cells: f64,
     /// Largest rotation per Newton step [rad].
     pub max_step_rotation: f64,
+    /// Pyramid levels to match on, coarse to fine (1 = the fine grid only,
+    /// the paper's method). Level `l` has cells `2^l` times the fine size.
+    /// Stage `l` (from `levels − 1` down to 0) starts from the previous
+    /// stage's pose and minimises `−Σ_{j ≥ l} E_j`: the score of its level plus
+    /// those of all coarser levels, so the final stage includes the fine cells.
+    pub levels: u32,
 }
 
 impl Default for MatchOptions {
@@ -55,6 +63,7 @@ impl Default for MatchOptions {
             rotation_tolerance: 1e-4,
             max_step_cells: 2.0,
             max_step_rotation: 0.05,
+            levels: 1,
         }
     }
 }
@@ -88,11 +97,15 @@ impl MatchOptions {
         Ok(())
     }
 
-    fn solver_options(&self, cell_size: f64) -> SolverOptions {
+    /// Solver settings on pyramid level `level` with cells of `cell_size` m:
+    /// coarse levels only need to land inside the next level's basin, so their
+    /// tolerances grow with the cell (× 2^level).
+    fn solver_options(&self, cell_size: f64, level: usize) -> SolverOptions {
+        let scale = f64::from(1u32 << level.min(30));
         SolverOptions {
             max_iterations: self.max_iterations,
-            translation_tolerance: self.translation_tolerance,
-            rotation_tolerance: self.rotation_tolerance,
+            translation_tolerance: self.translation_tolerance * scale,
+            rotation_tolerance: self.rotation_tolerance * scale,
             max_step_translation: self.max_step_cells * cell_size,
             max_step_rotation: self.max_step_rotation,
         }
@@ -195,17 +208,56 @@ impl NdtGrid {
                 limit,
             });
         }
-        let dists = self.distributions(options.dist_options());
-        let inv_cell = self.inv_cell_size();
-        let solver = options.solver_options(self.cell_size());
-        let outcome = minimise(guess, &solver, |pose, order| {
-            evaluate(&dists, points, pose, inv_cell, options, order)
-        });
+        let levels = options.levels as usize;
+        if levels == 0 || levels > self.levels() {
+            return Err(NdtError::InvalidOption {
+                name: "levels",
+                expected: "between 1 and the grid's number of pyramid levels",
+                value: f64::from(options.levels),
+            });
+        }
+        let mut pose = guess;
+        let mut iterations = 0;
+        let mut outcome = None;
+        let mut stack: Vec<Arc<Distributions>> = Vec::with_capacity(levels);
+        for level in (0..levels).rev() {
+            let Some(dists) = self.distributions(level, options.dist_options()) else {
+                break;
+            };
+            let cell = dists.cell_size();
+            let solver = options.solver_options(cell, level);
+            // Stage `level` minimises the sum of the scores of this level and
+            // every coarser one: the coarse levels keep the wall-scale
+            // structure that sparse fine cells lack (measured on Intel pairs:
+            // fine level alone after coarse-to-fine 23/50 successes, summed 35/50).
+            stack.push(dists);
+            let solved = minimise(pose, &solver, |p, order| {
+                let mut total = ScoreTerms::default();
+                for d in &stack {
+                    let t = evaluate(d, points, p, 1.0 / d.cell_size(), options, order);
+                    total.score += t.score;
+                    total.gradient += t.gradient;
+                    total.hessian += t.hessian;
+                    total.matched = total.matched.max(t.matched);
+                }
+                total
+            });
+            iterations += solved.iterations;
+            pose = solved.pose;
+            outcome = Some(solved);
+        }
+        let Some(outcome) = outcome else {
+            return Err(NdtError::InvalidOption {
+                name: "levels",
+                expected: "a level the grid has",
+                value: f64::from(options.levels),
+            });
+        };
         let hessian = outcome.terms.hessian;
         Ok(MatchResult {
             pose: outcome.pose,
             converged: outcome.converged,
-            iterations: outcome.iterations,
+            iterations,
             score: outcome.terms.score,
             num_matched: outcome.terms.matched,
             hessian,
@@ -224,7 +276,9 @@ impl NdtGrid {
         options.validate()?;
         check_finite("pose", &pose.to_array())?;
         check_points("points", points)?;
-        let dists = self.distributions(options.dist_options());
+        let dists = self
+            .distributions(0, options.dist_options())
+            .ok_or(NdtError::Empty { what: "levels" })?;
         Ok(evaluate(
             &dists,
             points,

@@ -30,31 +30,6 @@ pub struct PyNdtGrid {
     inner: RwLock<NdtGrid>,
 }
 
-#[allow(clippy::too_many_arguments)]
-fn match_options(
-    expansion: f64,
-    neighbor_search: bool,
-    fuse_minority: bool,
-    search_radius: u32,
-    max_iterations: u32,
-    translation_tolerance: f64,
-    rotation_tolerance: f64,
-    max_step_cells: f64,
-    max_step_rotation: f64,
-) -> MatchOptions {
-    MatchOptions {
-        expansion,
-        neighbor_search,
-        search_radius,
-        fuse_minority,
-        max_iterations,
-        translation_tolerance,
-        rotation_tolerance,
-        max_step_cells,
-        max_step_rotation,
-    }
-}
-
 impl PyNdtGrid {
     fn read<T>(&self, py: Python<'_>, f: impl FnOnce(&NdtGrid) -> T + Send) -> PyResult<T>
     where
@@ -71,11 +46,18 @@ impl PyNdtGrid {
 #[pymethods]
 impl PyNdtGrid {
     #[new]
-    #[pyo3(signature = (cell_size = 0.02))]
-    fn new(cell_size: f64) -> PyResult<Self> {
+    #[pyo3(signature = (cell_size = 0.02, *, levels = 5))]
+    fn new(cell_size: f64, levels: i64) -> PyResult<Self> {
+        let levels = count("levels", levels)? as usize;
         Ok(Self {
-            inner: RwLock::new(NdtGrid::new(cell_size).map_err(to_py)?),
+            inner: RwLock::new(NdtGrid::with_levels(cell_size, levels).map_err(to_py)?),
         })
+    }
+
+    /// Number of pyramid levels kept (fine level included).
+    #[getter]
+    fn levels(&self, py: Python<'_>) -> PyResult<usize> {
+        self.read(py, NdtGrid::levels)
     }
 
     /// Cell size [m].
@@ -116,7 +98,7 @@ impl PyNdtGrid {
     #[pyo3(name = "match", signature = (
         points, guess, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
         search_radius = 3, max_iterations = 50, translation_tolerance = 1e-4,
-        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05
+        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, levels = 1
     ))]
     #[allow(clippy::too_many_arguments)]
     fn match_scan(
@@ -133,18 +115,20 @@ impl PyNdtGrid {
         rotation_tolerance: f64,
         max_step_cells: f64,
         max_step_rotation: f64,
+        levels: i64,
     ) -> PyResult<PyMatchResult> {
-        let options = match_options(
+        let options = MatchOptions {
             expansion,
             neighbor_search,
+            search_radius: count("search_radius", search_radius)?,
             fuse_minority,
-            count("search_radius", search_radius)?,
-            count("max_iterations", max_iterations)?,
+            max_iterations: count("max_iterations", max_iterations)?,
             translation_tolerance,
             rotation_tolerance,
             max_step_cells,
             max_step_rotation,
-        );
+            levels: count("levels", levels)?,
+        };
         let pts = points_arg(points)?;
         let pairs = pts.as_pairs()?;
         let g = pose(guess, "guess")?;
@@ -278,5 +262,6 @@ pub fn default_match_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     out.set_item("rotation_tolerance", d.rotation_tolerance)?;
     out.set_item("max_step_cells", d.max_step_cells)?;
     out.set_item("max_step_rotation", d.max_step_rotation)?;
+    out.set_item("levels", d.levels)?;
     Ok(out)
 }

@@ -1,0 +1,122 @@
+//! The multi-resolution pyramid: level ℓ has cells `2^ℓ` times the fine size,
+//! and its sums are exact sums of the fine cells' eq. (6) terms (a coarse
+//! cell's `M, m, S` is the sum over the fine cells it covers). No point is
+//! stored, and no level is ever rebuilt: every insert adds to all levels.
+
+use nalgebra::Vector2;
+use rustc_hash::{FxHashMap, FxHashSet};
+
+use crate::cell::CellStats;
+use crate::key::CellKey;
+
+/// Most levels a grid may have (fine level included).
+pub const MAX_LEVELS: usize = 12;
+
+/// One level of the pyramid: cells of `cell_size` metres with their sums
+/// about each cell's centre.
+#[derive(Debug, Clone)]
+pub struct Level {
+    cell_size: f64,
+    cells: FxHashMap<CellKey, CellStats>,
+}
+
+impl Level {
+    /// Cell size of this level [m].
+    pub fn cell_size(&self) -> f64 {
+        self.cell_size
+    }
+
+    /// The sums of every occupied cell of this level, about each cell's centre.
+    pub fn cells(&self) -> &FxHashMap<CellKey, CellStats> {
+        &self.cells
+    }
+}
+
+/// The fine grid and its coarser levels.
+#[derive(Debug, Clone)]
+pub struct Pyramid {
+    levels: Vec<Level>,
+}
+
+/// The key of the level-`level` cell covering fine cell `key`: an arithmetic
+/// shift, i.e. floor division by `2^level` (correct for negative indices).
+#[inline]
+pub fn coarse_key(key: CellKey, level: usize) -> CellKey {
+    CellKey {
+        ix: key.ix >> level,
+        iy: key.iy >> level,
+    }
+}
+
+impl Pyramid {
+    /// An empty pyramid of `levels` levels over fine cells of `cell_size` m.
+    pub fn new(cell_size: f64, levels: usize) -> Self {
+        let levels = (0..levels.clamp(1, MAX_LEVELS))
+            .map(|l| Level {
+                cell_size: cell_size * f64::from(1u32 << l),
+                cells: FxHashMap::default(),
+            })
+            .collect();
+        Self { levels }
+    }
+
+    /// Number of levels (1 = the fine grid only).
+    pub fn len(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// `false`: a pyramid always has its fine level.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Level `l` (0 = fine).
+    pub fn level(&self, l: usize) -> Option<&Level> {
+        self.levels.get(l)
+    }
+
+    /// The fine level.
+    pub fn fine(&self) -> &Level {
+        &self.levels[0]
+    }
+
+    /// eq. (6) on every level for map-frame points `w` whose fine keys are
+    /// given. Scan points come in beam order, so runs of points in the same
+    /// coarse cell are summed first and added with one look-up.
+    ///
+    /// Returns, per level, the keys of the cells that changed.
+    pub fn add(&mut self, staged: &[(CellKey, Vector2<f64>)]) -> Vec<Vec<CellKey>> {
+        let mut touched_all = Vec::with_capacity(self.levels.len());
+        for (l, level) in self.levels.iter_mut().enumerate() {
+            let mut seen = FxHashSet::default();
+            let mut touched = Vec::new();
+            let mut flush = |key: CellKey, run: &CellStats| {
+                level.cells.entry(key).or_default().merge(run);
+                if seen.insert(key) {
+                    touched.push(key);
+                }
+            };
+            let mut run: Option<(CellKey, CellStats)> = None;
+            for &(fine, w) in staged {
+                let key = coarse_key(fine, l);
+                let centre = key.center(level.cell_size);
+                match &mut run {
+                    Some((k, stats)) if *k == key => stats.add_point(w - centre),
+                    _ => {
+                        if let Some((k, stats)) = run.take() {
+                            flush(k, &stats);
+                        }
+                        let mut stats = CellStats::default();
+                        stats.add_point(w - centre);
+                        run = Some((key, stats));
+                    }
+                }
+            }
+            if let Some((k, stats)) = run {
+                flush(k, &stats);
+            }
+            touched_all.push(touched);
+        }
+        touched_all
+    }
+}
