@@ -65,11 +65,17 @@ class NdtGrid:
     ----------
     cell_size : float, default 0.02
         Side of the square cells [m] (the paper: 2 cm).
+    levels : int, default 5
+        Levels of the multi-resolution pyramid kept with the map (1 = the fine
+        grid only, at most 12). Level ``l`` has cells ``cell_size * 2**l``; its
+        sums are exact sums of the fine cells' (no points are stored, nothing
+        is rebuilt), so coarse-to-fine matching (``match(levels=...)``) costs
+        no extra data.
 
     Raises
     ------
     ValueError
-        If ``cell_size`` is not a finite number > 0.
+        If ``cell_size`` is not a finite number > 0 or ``levels`` is not in 1..12.
 
     Notes
     -----
@@ -79,10 +85,13 @@ class NdtGrid:
     succeeds or leaves the map unchanged.
     """
 
-    def __init__(self, cell_size: float = 0.02) -> None: ...
+    def __init__(self, cell_size: float = 0.02, *, levels: int = 5) -> None: ...
     @property
     def cell_size(self) -> float:
         """Cell size [m]."""
+    @property
+    def levels(self) -> int:
+        """Pyramid levels kept (fine level included)."""
     def __len__(self) -> int:
         """Number of cells holding at least one point."""
     def insert(self, points: ArrayLike, pose: ArrayLike) -> None:
@@ -119,6 +128,7 @@ class NdtGrid:
         rotation_tolerance: float = 1e-4,
         max_step_cells: float = 2.0,
         max_step_rotation: float = 0.05,
+        levels: int = 1,
     ) -> MatchResult:
         """Match a scan against the map by Newton's method on eq. (1).
 
@@ -152,6 +162,12 @@ class NdtGrid:
             the narrow basin of a fine grid.
         max_step_rotation : float, default 0.05
             Largest rotation per Newton step [rad].
+        levels : int, default 1
+            Pyramid levels to match on, coarse to fine (1 = the fine grid only,
+            the paper's method; at most the grid's ``levels``). Stage ``l``
+            (from ``levels - 1`` down to 0) starts from the previous stage's
+            pose and maximises the summed score of its level and every coarser
+            one, so the last stage includes the fine cells.
 
         Returns
         -------
