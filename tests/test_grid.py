@@ -46,7 +46,7 @@ def test_api_names_and_shapes() -> None:
     assert original.num_matched > 0
     assert re.fullmatch(
         r"MatchResult\(pose=\[.*\], converged=(True|False), iterations=\d+, "
-        r"score=[\d.]+, num_matched=\d+\)",
+        r"score=[\d.]+, num_matched=\d+, degenerate=(True|False)\)",
         repr(res),
     )
     assert repr(grid) == f"NdtGrid(cell_size=0.02, cells={len(grid)})"

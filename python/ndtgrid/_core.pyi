@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -37,6 +38,15 @@ class MatchResult:
         as a log-likelihood). Eigenvalues of ``H`` below ``1e-9 * max|lambda|``
         (directions the scan does not constrain) are floored, giving very large
         but finite variances there.
+    unconstrained : ndarray, shape (K, 3)
+        Pose directions ``(dx, dy, dtheta)`` the scan does not constrain: the
+        eigenvectors of the Hessian, with rotation scaled to arc length at the
+        scan's RMS radius ``L``, whose eigenvalue is below 2 % of the largest.
+        Each row is scaled so that ``dx**2 + dy**2 + (L * dtheta)**2 = 1``. A
+        long corridor gives one row along the corridor. Empty (K = 0) when the
+        scan constrains every direction.
+    degenerate : bool
+        ``len(unconstrained) > 0``: fall back on odometry along those rows.
     """
 
     @property
@@ -53,6 +63,10 @@ class MatchResult:
     def hessian(self) -> F64Array: ...
     @property
     def covariance(self) -> F64Array: ...
+    @property
+    def unconstrained(self) -> F64Array: ...
+    @property
+    def degenerate(self) -> bool: ...
 
 class NdtGrid:
     """Sparse, unbounded NDT grid map (paper §III-B).
@@ -122,6 +136,7 @@ class NdtGrid:
         expansion: float = 10.0,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
+        pair_neighbors: bool = False,
         search_radius: int = 3,
         max_iterations: int = 50,
         translation_tolerance: float = 1e-4,
@@ -129,6 +144,7 @@ class NdtGrid:
         max_step_cells: float = 2.0,
         max_step_rotation: float = 0.05,
         levels: int = 1,
+        expansion_phases: Sequence[float] | None = None,
     ) -> MatchResult:
         """Match a scan against the map by Newton's method on eq. (1).
 
@@ -151,6 +167,12 @@ class NdtGrid:
         fuse_minority : bool, default True
             §IV-A(3): a cell with fewer than 3 points takes the distribution of
             the summed eq. (6) terms of itself and its 8 neighbours.
+        pair_neighbors : bool, default False
+            Score each point against every distribution of the 3x3 block of
+            cells around it (summed, as Biber's overlapping grids and
+            Magnusson's NDT do) instead of its own cell's alone; points with
+            none there fall back to the neighbour search. Smooths the score of
+            fine cells.
         search_radius : int, default 3
             Neighbour-search radius [cells], at most 1000.
         max_iterations : int, default 50
@@ -168,6 +190,10 @@ class NdtGrid:
             (from ``levels - 1`` down to 0) starts from the previous stage's
             pose and maximises the summed score of its level and every coarser
             one, so the last stage includes the fine cells.
+        expansion_phases : sequence of float, optional
+            The phased adjustment of the authors' earlier paper (ICRA 2008):
+            solve with each ``k`` in turn (e.g. ``[100, 10, 1]``), each from the
+            previous result; overrides ``expansion``.
 
         Returns
         -------
@@ -188,6 +214,7 @@ class NdtGrid:
         expansion: float = 10.0,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
+        pair_neighbors: bool = False,
         search_radius: int = 3,
     ) -> tuple[float, F64Array, F64Array, int]:
         """Score terms at ``pose`` without solving.

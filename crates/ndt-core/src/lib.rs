@@ -15,9 +15,11 @@
 #![warn(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 pub mod cell;
+pub mod degeneracy;
 pub mod distributions;
 pub mod error;
 pub mod grid;
+pub mod information;
 pub mod key;
 pub mod matcher;
 pub mod neighbor;

@@ -41,7 +41,8 @@ impl Default for ScoreTerms {
 
 impl ScoreTerms {
     /// Adds point `x` (scan frame) mapped to `xw = R(θ) x + t` (eq. 2) and
-    /// paired with `dist`. `(sin θ, cos θ)` are passed in so they are computed
+    /// paired with `dist` (the caller counts matched points: a point may be
+    /// paired with several distributions). `(sin θ, cos θ)` are passed in so they are computed
     /// once per pose, not per point.
     ///
     /// With `d = x' − q`, `C = Σ⁻¹`, `s = exp(−½ dᵀ C d)`,
@@ -68,7 +69,6 @@ impl ScoreTerms {
         // eq. (1): one point's contribution.
         let s = (-0.5 * e).exp();
         self.score += s;
-        self.matched += 1;
         if order == Order::Value {
             return;
         }

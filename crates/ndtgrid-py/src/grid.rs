@@ -97,8 +97,9 @@ impl PyNdtGrid {
     /// Matches scan-frame points against the map from `guess`.
     #[pyo3(name = "match", signature = (
         points, guess, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
-        search_radius = 3, max_iterations = 50, translation_tolerance = 1e-4,
-        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, levels = 1
+        pair_neighbors = false, search_radius = 3, max_iterations = 50, translation_tolerance = 1e-4,
+        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, levels = 1,
+        expansion_phases = None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn match_scan(
@@ -109,6 +110,7 @@ impl PyNdtGrid {
         expansion: f64,
         neighbor_search: bool,
         fuse_minority: bool,
+        pair_neighbors: bool,
         search_radius: i64,
         max_iterations: i64,
         translation_tolerance: f64,
@@ -116,12 +118,14 @@ impl PyNdtGrid {
         max_step_cells: f64,
         max_step_rotation: f64,
         levels: i64,
+        expansion_phases: Option<Vec<f64>>,
     ) -> PyResult<PyMatchResult> {
         let options = MatchOptions {
             expansion,
             neighbor_search,
             search_radius: count("search_radius", search_radius)?,
             fuse_minority,
+            pair_neighbors,
             max_iterations: count("max_iterations", max_iterations)?,
             translation_tolerance,
             rotation_tolerance,
@@ -137,15 +141,18 @@ impl PyNdtGrid {
             y: g[1],
             theta: g[2],
         };
-        self.read(py, |grid| grid.match_scan(pairs, guess, &options))?
-            .map(PyMatchResult::from)
-            .map_err(to_py)
+        self.read(py, |grid| match &expansion_phases {
+            Some(phases) => grid.match_phased(pairs, guess, &options, phases),
+            None => grid.match_scan(pairs, guess, &options),
+        })?
+        .map(PyMatchResult::from)
+        .map_err(to_py)
     }
 
     /// Score terms of eq. (1) at `pose` without solving.
     #[pyo3(signature = (
         points, pose, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
-        search_radius = 3
+        pair_neighbors = false, search_radius = 3
     ))]
     #[allow(clippy::too_many_arguments)]
     fn evaluate<'py>(
@@ -156,6 +163,7 @@ impl PyNdtGrid {
         expansion: f64,
         neighbor_search: bool,
         fuse_minority: bool,
+        pair_neighbors: bool,
         search_radius: i64,
     ) -> PyResult<Terms<'py>> {
         let defaults = MatchOptions::default();
@@ -163,6 +171,7 @@ impl PyNdtGrid {
             expansion,
             neighbor_search,
             fuse_minority,
+            pair_neighbors,
             search_radius: count("search_radius", search_radius)?,
             ..defaults
         };
@@ -256,6 +265,7 @@ pub fn default_match_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     out.set_item("expansion", d.expansion)?;
     out.set_item("neighbor_search", d.neighbor_search)?;
     out.set_item("fuse_minority", d.fuse_minority)?;
+    out.set_item("pair_neighbors", d.pair_neighbors)?;
     out.set_item("search_radius", d.search_radius)?;
     out.set_item("max_iterations", d.max_iterations)?;
     out.set_item("translation_tolerance", d.translation_tolerance)?;
@@ -263,5 +273,6 @@ pub fn default_match_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     out.set_item("max_step_cells", d.max_step_cells)?;
     out.set_item("max_step_rotation", d.max_step_rotation)?;
     out.set_item("levels", d.levels)?;
+    out.set_item("expansion_phases", py.None())?;
     Ok(out)
 }

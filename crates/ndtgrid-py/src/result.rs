@@ -1,7 +1,7 @@
 //! `ndtgrid.MatchResult`: a small frozen record of one match.
 
 use ndt_core::MatchResult;
-use numpy::{PyArray1, PyArray2};
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 
 use crate::convert::{mat3, rows, vec3};
@@ -20,6 +20,7 @@ pub struct PyMatchResult {
     num_matched: usize,
     hessian: [[f64; 3]; 3],
     covariance: [[f64; 3]; 3],
+    unconstrained: Vec<[f64; 3]>,
 }
 
 impl From<MatchResult> for PyMatchResult {
@@ -32,6 +33,7 @@ impl From<MatchResult> for PyMatchResult {
             num_matched: r.num_matched,
             hessian: rows(&r.hessian),
             covariance: rows(&r.covariance),
+            unconstrained: r.unconstrained,
         }
     }
 }
@@ -56,15 +58,33 @@ impl PyMatchResult {
         mat3(py, self.covariance)
     }
 
+    /// `(K, 3)` pose directions `(dx, dy, dtheta)` the scan does not constrain.
+    #[getter]
+    fn unconstrained<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let k = self.unconstrained.len();
+        PyArray1::from_vec(py, self.unconstrained.as_flattened().to_vec()).reshape([k, 3])
+    }
+
+    /// `True` when some pose direction is unconstrained.
+    #[getter]
+    fn degenerate(&self) -> bool {
+        !self.unconstrained.is_empty()
+    }
+
     fn __repr__(&self) -> String {
         let [x, y, t] = self.pose;
         format!(
             "MatchResult(pose=[{x:.6}, {y:.6}, {t:.6}], converged={}, iterations={}, \
-             score={:.3}, num_matched={})",
+             score={:.3}, num_matched={}, degenerate={})",
             if self.converged { "True" } else { "False" },
             self.iterations,
             self.score,
-            self.num_matched
+            self.num_matched,
+            if self.unconstrained.is_empty() {
+                "False"
+            } else {
+                "True"
+            }
         )
     }
 }

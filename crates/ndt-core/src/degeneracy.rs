@@ -1,0 +1,48 @@
+//! Which pose directions a scan leaves unconstrained, from the eigen-structure
+//! of its information matrix at the optimum (a long corridor leaves the along-corridor direction
+//! free), so a SLAM loop can fall back on odometry there.
+
+use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+
+/// A direction is unconstrained when its curvature is below this fraction of
+/// the strongest one (after scaling rotation to a length, see
+/// [`unconstrained_directions`]).
+pub const DEGENERACY_RATIO: f64 = 0.02;
+
+/// Unit directions `(dx, dy, L·dθ)` (rotation expressed as the arc length at
+/// lever arm `length` [m]) along which the information (or Hessian) matrix `h`
+/// (order `x, y, θ`) has an eigenvalue below [`DEGENERACY_RATIO`] times its
+/// largest.
+/// Scaling rotation by the scan's lever arm makes the three axes comparable:
+/// a rotation by `dθ` moves the points by about `L·dθ`.
+///
+/// Directions are returned in the original parameters `(dx, dy, dθ)`, scaled
+/// so that `dx² + dy² + (L·dθ)² = 1`, with the largest component positive.
+pub fn unconstrained_directions(h: &Matrix3<f64>, length: f64) -> Vec<[f64; 3]> {
+    let l = if length.is_finite() && length > 0.0 {
+        length
+    } else {
+        1.0
+    };
+    // q = (x, y, L θ): H_q = D H D with D = diag(1, 1, 1/L).
+    let d = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 1.0 / l));
+    let hq = d * h * d;
+    let eig = SymmetricEigen::new(hq);
+    let top = eig.eigenvalues.iter().fold(0.0_f64, |m, v| m.max(*v));
+    if top <= 0.0 {
+        // No curvature at all: nothing is constrained.
+        return vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0 / l]];
+    }
+    let mut out = Vec::new();
+    for i in 0..3 {
+        if eig.eigenvalues[i] < DEGENERACY_RATIO * top {
+            let v = eig.eigenvectors.column(i);
+            let big = (0..3)
+                .max_by(|&a, &b| v[a].abs().total_cmp(&v[b].abs()))
+                .unwrap_or(0);
+            let sign = if v[big] < 0.0 { -1.0 } else { 1.0 };
+            out.push([sign * v[0], sign * v[1], sign * v[2] / l]);
+        }
+    }
+    out
+}
