@@ -38,7 +38,8 @@ LOGS = {
     "MIT CSAIL": ("csail-corrected.log.gz", "mit_csail__csail-corrected__index.csv"),
 }
 MAX_RANGE = 40.0
-ORIGINAL = {"expansion": 1.0, "neighbor_search": False, "fuse_minority": False}
+PAPER = {"levels": 1, "pair_neighbors": False}
+ORIGINAL = {**PAPER, "expansion": 1.0, "neighbor_search": False, "fuse_minority": False}
 
 
 @dataclass
@@ -92,22 +93,19 @@ def methods() -> list[peer_lib.Peer]:
     out = [
         ours("NDT 2 cm original (k=1)", 0.02, **ORIGINAL),
         ours("NDT 20 cm original (k=1)", 0.2, **ORIGINAL),
-        ours("2 cm + expansion k=10 only", 0.02, expansion=10.0, neighbor_search=False,
-             fuse_minority=False),
-        ours("2 cm + neighbour search only", 0.02, expansion=1.0, neighbor_search=True,
-             fuse_minority=False),
-        ours("2 cm + fusion only", 0.02, expansion=1.0, neighbor_search=False,
-             fuse_minority=True),
-        ours("2 cm paper (all three fixes)", 0.02),
-        ours("2 cm pyramid 5 levels (to 32 cm)", 0.02, levels=5),
-        ours("2 cm pyramid 5 levels + 3×3 pairing", 0.02, levels=5, pair_neighbors=True),
-        ours("2 cm pyramid 5 levels + 3×3 pairing, no ring search", 0.02, levels=5,
-             pair_neighbors=True, neighbor_search=False),
+        ours("2 cm + expansion k=10 only", 0.02, **{**ORIGINAL, "expansion": 10.0}),
+        ours("2 cm + neighbour search only", 0.02, **{**ORIGINAL, "neighbor_search": True}),
+        ours("2 cm + fusion only", 0.02, **{**ORIGINAL, "fuse_minority": True}),
+        ours("2 cm paper (all three fixes)", 0.02, **PAPER),
+        ours("2 cm paper, phased k = 100, 10, 1", 0.02, **PAPER,
+             expansion_phases=[100.0, 10.0, 1.0]),
+        ours("2 cm paper + pyramid 5 levels (to 32 cm)", 0.02, levels=5,
+             pair_neighbors=False),
         ours("2 cm pyramid 6 levels + 3×3 pairing, no ring search", 0.02, levels=6,
-             pair_neighbors=True, neighbor_search=False),
+             neighbor_search=False),
         ours("16 cm pyramid 2 levels + 3×3 pairing (not 2 cm)", 0.16, levels=2,
-             pair_neighbors=True, neighbor_search=False),
-        ours("default match()", 0.02),
+             neighbor_search=False),
+        ours("default match(): paper + 5-level pyramid + 3×3 pairing", 0.02),
     ]
     return out + peer_lib.all_peers()
 

@@ -21,21 +21,14 @@ from ndtgrid.io import read_benchmark_index, read_carmen
 
 REAL = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real"
 
+PAPER = {"levels": 1, "pair_neighbors": False}
+ORIGINAL = {**PAPER, "expansion": 1.0, "neighbor_search": False, "fuse_minority": False}
 SETTINGS = {
-    "2 cm, pyramid 5 levels": (0.02, {"levels": 5}),
-    "2 cm, pyramid 4 levels": (0.02, {"levels": 4}),
-    "2 cm, pyramid 3 levels": (0.02, {"levels": 3}),
-    "2 cm, paper (k=10, neighbours, fusion)": (0.02, {}),
-    "2 cm, original NDT (k=1)": (
-        0.02,
-        {"expansion": 1.0, "neighbor_search": False, "fuse_minority": False},
-    ),
-    "5 cm, paper": (0.05, {}),
-    "20 cm, paper": (0.2, {}),
-    "20 cm, original NDT (k=1)": (
-        0.2,
-        {"expansion": 1.0, "neighbor_search": False, "fuse_minority": False},
-    ),
+    "2 cm, default match() (5-level pyramid, 3×3 pairing)": (0.02, {}),
+    "2 cm, paper (k=10, neighbours, fusion)": (0.02, PAPER),
+    "2 cm, original NDT (k=1)": (0.02, ORIGINAL),
+    "20 cm, paper": (0.2, PAPER),
+    "20 cm, original NDT (k=1)": (0.2, ORIGINAL),
 }
 
 

@@ -33,12 +33,17 @@ def pairs() -> list[ndtgrid.evaluation.ScanPair]:
     return out[:N_PAIRS]
 
 
-def errors(pairs: list[ndtgrid.evaluation.ScanPair], cell: float) -> tuple[np.ndarray, ...]:
+PAPER = {"levels": 1, "pair_neighbors": False}
+
+
+def errors(
+    pairs: list[ndtgrid.evaluation.ScanPair], cell: float, **options: object
+) -> tuple[np.ndarray, ...]:
     guess, match = [], []
     for p in pairs:
         grid = ndtgrid.NdtGrid(cell)
         grid.insert(p.reference_points, p.reference_pose)
-        res = grid.match(p.points, p.guess)
+        res = grid.match(p.points, p.guess, **options)  # type: ignore[arg-type]
         guess.append(pose_error(p.guess, p.true_pose))
         match.append(pose_error(res.pose, p.true_pose))
     return np.array(guess), np.array(match)
@@ -54,16 +59,32 @@ def test_guesses_are_as_described(pairs: list[ndtgrid.evaluation.ScanPair]) -> N
 def test_matching_beats_the_odometry_guess_on_20cm_grid(
     pairs: list[ndtgrid.evaluation.ScanPair],
 ) -> None:
-    guess, match = errors(pairs, 0.2)
+    guess, match = errors(pairs, 0.2, **PAPER)
     ok = lambda e: (e[:, 0] < 0.05) & (e[:, 1] < np.radians(1.0))  # noqa: E731
     assert np.median(match[:, 0]) < 0.6 * np.median(guess[:, 0])
     assert np.median(match[:, 1]) < 0.25 * np.median(guess[:, 1])
     assert ok(match).sum() >= 3 * ok(guess).sum()
 
 
-def test_2cm_grid_improves_rotation(pairs: list[ndtgrid.evaluation.ScanPair]) -> None:
-    # A single 1-degree SICK scan leaves most 2 cm cells with one point: the
-    # paper's method still improves the rotation, not yet the translation
-    # (the coarse-to-fine work of the convergence issue addresses that).
+def test_2cm_default_beats_the_odometry_guess(
+    pairs: list[ndtgrid.evaluation.ScanPair],
+) -> None:
+    # Measured: 26/50 successes (guess 6/50), median 4.1 cm / 0.56 deg
+    # (guess 5.1 cm / 2.61 deg). The 20 cm grid does better on these sparse
+    # scan-to-scan pairs (37/50); BENCHMARK.md has the study.
     guess, match = errors(pairs, 0.02)
+    ok = lambda e: (e[:, 0] < 0.05) & (e[:, 1] < np.radians(1.0))  # noqa: E731
+    assert np.median(match[:, 0]) < 0.85 * np.median(guess[:, 0])
+    assert np.median(match[:, 1]) < 0.25 * np.median(guess[:, 1])
+    assert ok(match).sum() >= 3 * ok(guess).sum()
+
+
+def test_2cm_paper_method_alone_improves_rotation_only(
+    pairs: list[ndtgrid.evaluation.ScanPair],
+) -> None:
+    # A single 1-degree SICK scan leaves most 2 cm cells with one point: the
+    # paper's method alone improves the rotation, not the translation, which is
+    # why the default adds the pyramid.
+    guess, match = errors(pairs, 0.02, **PAPER)
     assert np.median(match[:, 1]) < 0.85 * np.median(guess[:, 1])
+    assert np.median(match[:, 0]) > 0.8 * np.median(guess[:, 0])

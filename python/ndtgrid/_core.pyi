@@ -136,21 +136,24 @@ class NdtGrid:
         expansion: float = 10.0,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
-        pair_neighbors: bool = False,
+        pair_neighbors: bool = True,
         search_radius: int = 3,
         max_iterations: int = 50,
         translation_tolerance: float = 1e-4,
         rotation_tolerance: float = 1e-4,
         max_step_cells: float = 2.0,
         max_step_rotation: float = 0.05,
-        levels: int = 1,
+        levels: int = 5,
         expansion_phases: Sequence[float] | None = None,
     ) -> MatchResult:
         """Match a scan against the map by Newton's method on eq. (1).
 
-        The defaults are the paper's method (§IV-A). The original NDT of Biber
-        & Strasser on the same grid is ``expansion=1.0, neighbor_search=False,
-        fuse_minority=False``.
+        The defaults are the paper's method (§IV-A: k = 10, neighbour search and
+        fusion on) run coarse to fine over 5 pyramid levels with 3x3 pairing:
+        the best setting measured by ``benches/convergence.py`` (BENCHMARK.md).
+        The paper's method alone is ``levels=1, pair_neighbors=False``; the
+        original NDT of Biber & Strasser on the same grid is additionally
+        ``expansion=1.0, neighbor_search=False, fuse_minority=False``.
 
         Parameters
         ----------
@@ -167,7 +170,7 @@ class NdtGrid:
         fuse_minority : bool, default True
             §IV-A(3): a cell with fewer than 3 points takes the distribution of
             the summed eq. (6) terms of itself and its 8 neighbours.
-        pair_neighbors : bool, default False
+        pair_neighbors : bool, default True
             Score each point against every distribution of the 3x3 block of
             cells around it (summed, as Biber's overlapping grids and
             Magnusson's NDT do) instead of its own cell's alone; points with
@@ -184,12 +187,12 @@ class NdtGrid:
             the narrow basin of a fine grid.
         max_step_rotation : float, default 0.05
             Largest rotation per Newton step [rad].
-        levels : int, default 1
+        levels : int, default 5
             Pyramid levels to match on, coarse to fine (1 = the fine grid only,
             the paper's method; at most the grid's ``levels``). Stage ``l``
             (from ``levels - 1`` down to 0) starts from the previous stage's
-            pose and maximises the summed score of its level and every coarser
-            one, so the last stage includes the fine cells.
+            pose and maximises the summed score of its level and the next
+            coarser one, so the last stage includes the fine cells.
         expansion_phases : sequence of float, optional
             The phased adjustment of the authors' earlier paper (ICRA 2008):
             solve with each ``k`` in turn (e.g. ``[100, 10, 1]``), each from the
@@ -214,7 +217,7 @@ class NdtGrid:
         expansion: float = 10.0,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
-        pair_neighbors: bool = False,
+        pair_neighbors: bool = True,
         search_radius: int = 3,
     ) -> tuple[float, F64Array, F64Array, int]:
         """Score terms at ``pose`` without solving.

@@ -28,9 +28,12 @@ pub const MAX_SEARCH_RADIUS: u32 = 1000;
 pub const LEVEL_WINDOW: usize = 2;
 
 /// Options of [`NdtGrid::match_scan`]. The defaults are the paper's method
-/// (§IV-A): `k = 10`, neighbour search and fusion on. The original NDT of
-/// Biber & Strasser on the same grid is `expansion = 1`,
-/// `neighbor_search = false`, `fuse_minority = false`.
+/// (§IV-A: `k = 10`, neighbour search and fusion on) run coarse to fine over
+/// 5 pyramid levels with 3×3 pairing — the best of the settings measured by
+/// `benches/convergence.py` (see BENCHMARK.md). The paper's method alone is
+/// `levels = 1, pair_neighbors = false`; the original NDT of Biber & Strasser
+/// on the same grid is additionally `expansion = 1`, `neighbor_search =
+/// false`, `fuse_minority = false`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MatchOptions {
     /// `k` of eq. (8) (> 0; 1 = no expansion).
@@ -74,13 +77,13 @@ impl Default for MatchOptions {
             neighbor_search: true,
             search_radius: 3,
             fuse_minority: true,
-            pair_neighbors: false,
+            pair_neighbors: true,
             max_iterations: 50,
             translation_tolerance: 1e-4,
             rotation_tolerance: 1e-4,
             max_step_cells: 2.0,
             max_step_rotation: 0.05,
-            levels: 1,
+            levels: 5,
         }
     }
 }

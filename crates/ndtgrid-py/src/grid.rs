@@ -97,8 +97,8 @@ impl PyNdtGrid {
     /// Matches scan-frame points against the map from `guess`.
     #[pyo3(name = "match", signature = (
         points, guess, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
-        pair_neighbors = false, search_radius = 3, max_iterations = 50, translation_tolerance = 1e-4,
-        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, levels = 1,
+        pair_neighbors = true, search_radius = 3, max_iterations = 50, translation_tolerance = 1e-4,
+        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, levels = 5,
         expansion_phases = None
     ))]
     #[allow(clippy::too_many_arguments)]
@@ -152,7 +152,7 @@ impl PyNdtGrid {
     /// Score terms of eq. (1) at `pose` without solving.
     #[pyo3(signature = (
         points, pose, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
-        pair_neighbors = false, search_radius = 3
+        pair_neighbors = true, search_radius = 3
     ))]
     #[allow(clippy::too_many_arguments)]
     fn evaluate<'py>(
