@@ -38,7 +38,7 @@ LOGS = {
     "MIT CSAIL": ("csail-corrected.log.gz", "mit_csail__csail-corrected__index.csv"),
 }
 MAX_RANGE = 40.0
-PAPER = {"levels": 1, "pair_neighbors": False}
+PAPER = {"levels": 1, "pair_neighbors": False, "freeze_unconstrained": False, "search_radius": 3}
 ORIGINAL = {**PAPER, "expansion": 1.0, "neighbor_search": False, "fuse_minority": False}
 
 
@@ -97,27 +97,31 @@ def methods() -> list[peer_lib.Peer]:
         ours("2 cm + neighbour search only", 0.02, **{**ORIGINAL, "neighbor_search": True}),
         ours("2 cm + fusion only", 0.02, **{**ORIGINAL, "fuse_minority": True}),
         ours("2 cm paper (all three fixes)", 0.02, **PAPER),
-        ours("2 cm paper, phased k = 100, 10, 1", 0.02, **PAPER,
-             expansion_phases=[100.0, 10.0, 1.0]),
-        ours("2 cm paper + pyramid 5 levels (to 32 cm)", 0.02, levels=5,
-             pair_neighbors=False),
-        ours("2 cm pyramid 6 levels + 3×3 pairing, no ring search", 0.02, levels=6,
-             neighbor_search=False),
-        ours("16 cm pyramid 2 levels + 3×3 pairing (not 2 cm)", 0.16, levels=2,
-             neighbor_search=False),
-        ours("default match(): paper + 5-level pyramid + 3×3 pairing", 0.02),
+        ours(
+            "2 cm paper, phased k = 100, 10, 1", 0.02, **PAPER, expansion_phases=[100.0, 10.0, 1.0]
+        ),
+        ours("2 cm paper + pyramid 5 levels (to 32 cm)", 0.02, levels=5, pair_neighbors=False),
+        ours(
+            "2 cm pyramid 6 levels + 3×3 pairing, ring search r=3",
+            0.02,
+            search_radius=3,
+            freeze_unconstrained=False,
+        ),
+        ours("2 cm pyramid 6 levels + 3×3 pairing", 0.02, freeze_unconstrained=False),
+        ours("default match(): + frozen unconstrained directions", 0.02),
+        ours("16 cm grid, default match() (not 2 cm)", 0.16),
     ]
     return out + peer_lib.all_peers()
 
 
 def starts(rng: np.random.Generator, n: int, trans: float, rot_deg: float) -> np.ndarray:
     """(n, 3) perturbations, uniform in ±trans, ±rot."""
-    return np.c_[rng.uniform(-trans, trans, (n, 2)),
-                 np.radians(rng.uniform(-rot_deg, rot_deg, n))]
+    return np.c_[rng.uniform(-trans, trans, (n, 2)), np.radians(rng.uniform(-rot_deg, rot_deg, n))]
 
 
-def run(pairs: list[Pair], ms: list[peer_lib.Peer], perturb: Callable[[int], np.ndarray],
-        title: str) -> None:
+def run(
+    pairs: list[Pair], ms: list[peer_lib.Peer], perturb: Callable[[int], np.ndarray], title: str
+) -> None:
     """Print one table: success, median error, median time per method."""
     print(f"\n### {title}\n")
     print("| method | success | median error [cm / °] | median time [ms] |")
@@ -135,9 +139,11 @@ def run(pairs: list[Pair], ms: list[peer_lib.Peer], perturb: Callable[[int], np.
                 errs.append((et, er))
                 ok += et < 0.05 and er < np.radians(1.0)
         e = np.array(errs)
-        print(f"| {m.name} | {100 * ok / len(e):.0f} % | {100 * np.median(e[:, 0]):.1f} / "
-              f"{np.degrees(np.median(e[:, 1])):.2f} | {1e3 * np.median(times):.2f} |",
-              flush=True)
+        print(
+            f"| {m.name} | {100 * ok / len(e):.0f} % | {100 * np.median(e[:, 0]):.1f} / "
+            f"{np.degrees(np.median(e[:, 1])):.2f} | {1e3 * np.median(times):.2f} |",
+            flush=True,
+        )
 
 
 def main() -> None:

@@ -21,10 +21,13 @@ from ndtgrid.io import read_benchmark_index, read_carmen
 
 REAL = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real"
 
-PAPER = {"levels": 1, "pair_neighbors": False}
+PAPER = {"levels": 1, "pair_neighbors": False, "freeze_unconstrained": False, "search_radius": 3}
 ORIGINAL = {**PAPER, "expansion": 1.0, "neighbor_search": False, "fuse_minority": False}
 SETTINGS = {
-    "2 cm, default match() (5-level pyramid, 3×3 pairing)": (0.02, {}),
+    "2 cm, default match() (2–64 cm pyramid, 3×3 pairing, frozen degenerate directions)": (
+        0.02,
+        {},
+    ),
     "2 cm, paper (k=10, neighbours, fusion)": (0.02, PAPER),
     "2 cm, original NDT (k=1)": (0.02, ORIGINAL),
     "20 cm, paper": (0.2, PAPER),
@@ -38,9 +41,7 @@ def main() -> None:
     parser.add_argument("--pairs", type=int, default=50)
     args = parser.parse_args()
     scans = list(read_carmen(REAL / "radish-gfs-corrected/intel-corrected.log.gz"))
-    index = read_benchmark_index(
-        REAL / "benchmark-scans-split/intel__intel-corrected__index.csv"
-    )
+    index = read_benchmark_index(REAL / "benchmark-scans-split/intel__intel-corrected__index.csv")
     pairs = list(corrected_pairs(scans, index, max_range=40.0))[: args.pairs]
     guess = np.array([pose_error(p.guess, p.true_pose) for p in pairs])
     print(f"{len(pairs)} Intel pairs")

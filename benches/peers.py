@@ -63,8 +63,15 @@ def small_gicp_peers() -> list[Peer]:
         src, _ = small_gicp.preprocess_points(lift(pts), MERGE, num_neighbors=10)
         t = to_matrix(guess)
         for gate in (1.0, 0.25):
-            r = small_gicp.align(cloud, src, tree, t, registration_type="GICP",
-                                 max_correspondence_distance=gate, max_iterations=30)
+            r = small_gicp.align(
+                cloud,
+                src,
+                tree,
+                t,
+                registration_type="GICP",
+                max_correspondence_distance=gate,
+                max_iterations=30,
+            )
             t = r.T_target_source
         return to_pose(t)
 
@@ -104,8 +111,11 @@ def open3d_peers() -> list[Peer]:
         return pc
 
     def make(plane: bool) -> Peer:
-        method = (reg.TransformationEstimationPointToPlane() if plane
-                  else reg.TransformationEstimationPointToPoint())
+        method = (
+            reg.TransformationEstimationPointToPlane()
+            if plane
+            else reg.TransformationEstimationPointToPoint()
+        )
 
         def prepare(target: F64) -> Any:
             return cloud(target, plane)
@@ -114,9 +124,9 @@ def open3d_peers() -> list[Peer]:
             src = cloud(pts, False)
             t = to_matrix(guess)
             for gate in (1.0, 0.25, 0.1):
-                t = reg.registration_icp(src, state, gate, t, method,
-                                         reg.ICPConvergenceCriteria(max_iteration=30)
-                                         ).transformation
+                t = reg.registration_icp(
+                    src, state, gate, t, method, reg.ICPConvergenceCriteria(max_iteration=30)
+                ).transformation
             return to_pose(np.asarray(t))
 
         kind = "point-to-plane" if plane else "point-to-point"

@@ -33,7 +33,7 @@ def pairs() -> list[ndtgrid.evaluation.ScanPair]:
     return out[:N_PAIRS]
 
 
-PAPER = {"levels": 1, "pair_neighbors": False}
+PAPER = {"levels": 1, "pair_neighbors": False, "freeze_unconstrained": False, "search_radius": 3}
 
 
 def errors(
@@ -69,14 +69,13 @@ def test_matching_beats_the_odometry_guess_on_20cm_grid(
 def test_2cm_default_beats_the_odometry_guess(
     pairs: list[ndtgrid.evaluation.ScanPair],
 ) -> None:
-    # Measured: 26/50 successes (guess 6/50), median 4.1 cm / 0.56 deg
-    # (guess 5.1 cm / 2.61 deg). The 20 cm grid does better on these sparse
-    # scan-to-scan pairs (37/50); BENCHMARK.md has the study.
+    # Measured: 36/50 successes (guess 6/50), median 3.0 cm / 0.34 deg
+    # (guess 5.1 cm / 2.61 deg); the reference itself is good to a few cm.
     guess, match = errors(pairs, 0.02)
     ok = lambda e: (e[:, 0] < 0.05) & (e[:, 1] < np.radians(1.0))  # noqa: E731
-    assert np.median(match[:, 0]) < 0.85 * np.median(guess[:, 0])
-    assert np.median(match[:, 1]) < 0.25 * np.median(guess[:, 1])
-    assert ok(match).sum() >= 3 * ok(guess).sum()
+    assert np.median(match[:, 0]) < 0.7 * np.median(guess[:, 0])
+    assert np.median(match[:, 1]) < 0.2 * np.median(guess[:, 1])
+    assert ok(match).sum() >= 5 * ok(guess).sum()
 
 
 def test_2cm_paper_method_alone_improves_rotation_only(

@@ -79,7 +79,7 @@ class NdtGrid:
     ----------
     cell_size : float, default 0.02
         Side of the square cells [m] (the paper: 2 cm).
-    levels : int, default 5
+    levels : int, default 6
         Levels of the multi-resolution pyramid kept with the map (1 = the fine
         grid only, at most 12). Level ``l`` has cells ``cell_size * 2**l``; its
         sums are exact sums of the fine cells' (no points are stored, nothing
@@ -99,7 +99,7 @@ class NdtGrid:
     succeeds or leaves the map unchanged.
     """
 
-    def __init__(self, cell_size: float = 0.02, *, levels: int = 5) -> None: ...
+    def __init__(self, cell_size: float = 0.02, *, levels: int = 6) -> None: ...
     @property
     def cell_size(self) -> float:
         """Cell size [m]."""
@@ -137,23 +137,27 @@ class NdtGrid:
         neighbor_search: bool = True,
         fuse_minority: bool = True,
         pair_neighbors: bool = True,
-        search_radius: int = 3,
+        search_radius: int = 1,
         max_iterations: int = 50,
         translation_tolerance: float = 1e-4,
         rotation_tolerance: float = 1e-4,
         max_step_cells: float = 2.0,
         max_step_rotation: float = 0.05,
-        levels: int = 5,
+        freeze_unconstrained: bool = True,
+        levels: int | None = None,
         expansion_phases: Sequence[float] | None = None,
     ) -> MatchResult:
         """Match a scan against the map by Newton's method on eq. (1).
 
         The defaults are the paper's method (§IV-A: k = 10, neighbour search and
-        fusion on) run coarse to fine over 5 pyramid levels with 3x3 pairing:
-        the best setting measured by ``benches/convergence.py`` (BENCHMARK.md).
-        The paper's method alone is ``levels=1, pair_neighbors=False``; the
-        original NDT of Biber & Strasser on the same grid is additionally
-        ``expansion=1.0, neighbor_search=False, fuse_minority=False``.
+        fusion on) run coarse to fine over the pyramid (2-64 cm on a 2 cm grid)
+        with 3x3 pairing
+        and unconstrained directions frozen: the best setting measured by
+        ``benches/convergence.py`` (BENCHMARK.md). The paper's method alone is
+        ``levels=1, pair_neighbors=False, freeze_unconstrained=False,
+        search_radius=3``; the original NDT of Biber & Strasser on the same
+        grid is additionally ``expansion=1.0, neighbor_search=False,
+        fuse_minority=False``.
 
         Parameters
         ----------
@@ -176,8 +180,10 @@ class NdtGrid:
             Magnusson's NDT do) instead of its own cell's alone; points with
             none there fall back to the neighbour search. Smooths the score of
             fine cells.
-        search_radius : int, default 3
-            Neighbour-search radius [cells], at most 1000.
+        search_radius : int, default 1
+            Neighbour-search radius [cells], at most 1000. With 3x3 pairing a
+            radius of 1 is the block itself; larger radii measured worse on
+            real scan pairs (points paired with the wrong wall).
         max_iterations : int, default 50
             Newton steps at most.
         translation_tolerance, rotation_tolerance : float, default 1e-4
@@ -187,9 +193,17 @@ class NdtGrid:
             the narrow basin of a fine grid.
         max_step_rotation : float, default 0.05
             Largest rotation per Newton step [rad].
-        levels : int, default 5
+        freeze_unconstrained : bool, default True
+            From the second pyramid stage on, project Newton steps onto the
+            pose directions the scan constrains (point-to-plane information,
+            see ``MatchResult.unconstrained``): along a corridor's axis the
+            pose stays where the guess and the coarse stages put it instead of
+            being dragged by fine cells ("solution remapping").
+        levels : int, optional
             Pyramid levels to match on, coarse to fine (1 = the fine grid only,
-            the paper's method; at most the grid's ``levels``). Stage ``l``
+            the paper's method; at most the grid's ``levels``). By default as
+            many as keep the coarsest cell at most 0.64 m: 6 levels (2-64 cm)
+            on a 2 cm grid, 2 on a 20 cm grid. Stage ``l``
             (from ``levels - 1`` down to 0) starts from the previous stage's
             pose and maximises the summed score of its level and the next
             coarser one, so the last stage includes the fine cells.
@@ -218,7 +232,7 @@ class NdtGrid:
         neighbor_search: bool = True,
         fuse_minority: bool = True,
         pair_neighbors: bool = True,
-        search_radius: int = 3,
+        search_radius: int = 1,
     ) -> tuple[float, F64Array, F64Array, int]:
         """Score terms at ``pose`` without solving.
 

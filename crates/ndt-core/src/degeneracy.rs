@@ -46,3 +46,24 @@ pub fn unconstrained_directions(h: &Matrix3<f64>, length: f64) -> Vec<[f64; 3]> 
     }
     out
 }
+
+/// The projection `D (I − Σ uuᵀ) D⁻¹` (with `D = diag(1, 1, 1/L)`) that removes
+/// the unconstrained directions `u` of [`unconstrained_directions`] from a
+/// pose step `(dx, dy, dθ)`: the solver then leaves the pose where the guess
+/// put it along those directions ("solution remapping", Zhang et al., ICRA
+/// 2016), instead of drifting along a corridor.
+pub fn constrained_projector(h: &Matrix3<f64>, length: f64) -> Matrix3<f64> {
+    let l = if length.is_finite() && length > 0.0 {
+        length
+    } else {
+        1.0
+    };
+    let d = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 1.0 / l));
+    let d_inv = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, l));
+    let mut p = Matrix3::identity();
+    for u in unconstrained_directions(h, l) {
+        let q = Vector3::new(u[0], u[1], u[2] * l);
+        p -= q * q.transpose();
+    }
+    d * p * d_inv
+}

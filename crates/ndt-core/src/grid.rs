@@ -17,9 +17,9 @@ use crate::se2::Pose2;
 /// expansion/fusion setting) a grid keeps between calls.
 const PREPARED_CAPACITY: usize = 24;
 
-/// Pyramid levels of a new grid: the fine cells and four coarser levels
-/// (with 2 cm cells: 2, 4, 8, 16 and 32 cm).
-pub const DEFAULT_LEVELS: usize = 5;
+/// Pyramid levels of a new grid: the fine cells and five coarser levels
+/// (with 2 cm cells: 2, 4, 8, 16, 32 and 64 cm).
+pub const DEFAULT_LEVELS: usize = 6;
 
 /// One cell as returned to callers: index and the paper's sums in map
 /// coordinates (`m = Σx`, `S = Σ x xᵀ`).

@@ -5,7 +5,7 @@ use std::sync::Arc;
 use nalgebra::{Matrix3, Vector2};
 
 use crate::cell::Gaussian;
-use crate::degeneracy::unconstrained_directions;
+use crate::degeneracy::{constrained_projector, unconstrained_directions};
 use crate::distributions::{DistOptions, Distributions};
 use crate::error::{check_finite, NdtError, Result};
 use crate::grid::{check_points, NdtGrid};
@@ -27,13 +27,19 @@ pub const MAX_SEARCH_RADIUS: u32 = 1000;
 /// with a window of 2, 78 % / 73 % with 3.
 pub const LEVEL_WINDOW: usize = 2;
 
+/// Largest coarsest-level cell [m] of the automatic level count: the coarse
+/// stage must still see a room's walls as separate structures.
+pub const AUTO_COARSEST_CELL: f64 = 0.64;
+
 /// Options of [`NdtGrid::match_scan`]. The defaults are the paper's method
 /// (§IV-A: `k = 10`, neighbour search and fusion on) run coarse to fine over
-/// 5 pyramid levels with 3×3 pairing — the best of the settings measured by
-/// `benches/convergence.py` (see BENCHMARK.md). The paper's method alone is
-/// `levels = 1, pair_neighbors = false`; the original NDT of Biber & Strasser
-/// on the same grid is additionally `expansion = 1`, `neighbor_search =
-/// false`, `fuse_minority = false`.
+/// 6 pyramid levels with 3×3 pairing (which makes a neighbour-search radius
+/// of 1 cell enough) and unconstrained directions frozen — the best of the
+/// settings measured by `benches/convergence.py` (see BENCHMARK.md). The
+/// paper's method alone is `levels = 1, pair_neighbors = false,
+/// freeze_unconstrained = false, search_radius = 3`; the original NDT of Biber
+/// & Strasser on the same grid is additionally `expansion = 1`,
+/// `neighbor_search = false`, `fuse_minority = false`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MatchOptions {
     /// `k` of eq. (8) (> 0; 1 = no expansion).
@@ -61,13 +67,21 @@ pub struct MatchOptions {
     pub max_step_cells: f64,
     /// Largest rotation per Newton step [rad].
     pub max_step_rotation: f64,
+    /// Keep the pose where the previous stage put it along directions the
+    /// scan does not constrain (a corridor's axis), instead of letting fine
+    /// cells drag it along: from the second stage on, Newton steps are
+    /// projected onto the constrained directions of the point-to-plane
+    /// information (see [`crate::degeneracy::constrained_projector`]).
+    pub freeze_unconstrained: bool,
     /// Pyramid levels to match on, coarse to fine (1 = the fine grid only,
     /// the paper's method). Level `l` has cells `2^l` times the fine size.
     /// Stage `l` (from `levels − 1` down to 0) starts from the previous
     /// stage's pose and minimises `−(E_l + E_{l+1})`: its level's score plus
     /// the next coarser one's (see [`LEVEL_WINDOW`]), so the final stage
-    /// includes the fine cells.
-    pub levels: u32,
+    /// includes the fine cells. `None`: as many of the grid's levels as keep
+    /// the coarsest cell at most [`AUTO_COARSEST_CELL`] (with 2 cm cells: 6
+    /// levels, 2–64 cm; with 20 cm cells: 2 levels).
+    pub levels: Option<u32>,
 }
 
 impl Default for MatchOptions {
@@ -75,7 +89,7 @@ impl Default for MatchOptions {
         Self {
             expansion: 10.0,
             neighbor_search: true,
-            search_radius: 3,
+            search_radius: 1,
             fuse_minority: true,
             pair_neighbors: true,
             max_iterations: 50,
@@ -83,7 +97,8 @@ impl Default for MatchOptions {
             rotation_tolerance: 1e-4,
             max_step_cells: 2.0,
             max_step_rotation: 0.05,
-            levels: 5,
+            freeze_unconstrained: true,
+            levels: None,
         }
     }
 }
@@ -128,6 +143,7 @@ impl MatchOptions {
             rotation_tolerance: self.rotation_tolerance * scale,
             max_step_translation: self.max_step_cells * cell_size,
             max_step_rotation: self.max_step_rotation,
+            projector: Matrix3::identity(),
         }
     }
 
@@ -252,14 +268,28 @@ impl NdtGrid {
                 limit,
             });
         }
-        let levels = options.levels as usize;
+        let levels = match options.levels {
+            Some(l) => l as usize,
+            None => (1..=self.levels())
+                .take_while(|&l| {
+                    self.cell_size() * f64::from(1u32 << (l - 1)) <= AUTO_COARSEST_CELL * 1.0001
+                })
+                .last()
+                .unwrap_or(1),
+        };
         if levels == 0 || levels > self.levels() {
             return Err(NdtError::InvalidOption {
                 name: "levels",
                 expected: "between 1 and the grid's number of pyramid levels",
-                value: f64::from(options.levels),
+                value: levels as f64,
             });
         }
+        let lever = (points
+            .iter()
+            .map(|p| p[0] * p[0] + p[1] * p[1])
+            .sum::<f64>()
+            / points.len() as f64)
+            .sqrt();
         let mut pose = guess;
         let mut iterations = 0;
         let mut outcome = None;
@@ -269,10 +299,18 @@ impl NdtGrid {
                 break;
             };
             let cell = dists.cell_size();
-            let solver = options.solver_options(cell, level);
+            let mut solver = options.solver_options(cell, level);
             stack.push(dists);
             if stack.len() > LEVEL_WINDOW {
                 stack.remove(0);
+            }
+            // Not on the first stage: its start may be far off, and pairs
+            // found there would misjudge the geometry.
+            if options.freeze_unconstrained && level + 1 < levels {
+                if let Some(d) = stack.first() {
+                    let info = point_to_plane_information(own_cell_pairs(d, points, pose), pose);
+                    solver.projector = constrained_projector(&info, lever);
+                }
             }
             let solved = minimise(pose, &solver, |p, order| {
                 let mut total = ScoreTerms::default();
@@ -293,7 +331,7 @@ impl NdtGrid {
             return Err(NdtError::InvalidOption {
                 name: "levels",
                 expected: "a level the grid has",
-                value: f64::from(options.levels),
+                value: levels as f64,
             });
         };
         let hessian = outcome.terms.hessian;

@@ -40,6 +40,10 @@ pub struct SolverOptions {
     pub max_step_translation: f64,
     /// Largest rotation per iteration [rad].
     pub max_step_rotation: f64,
+    /// Steps are multiplied by this matrix before use: the identity, or a
+    /// projection that removes the directions a scan does not constrain
+    /// (see [`crate::degeneracy::constrained_projector`]).
+    pub projector: Matrix3<f64>,
 }
 
 impl Default for SolverOptions {
@@ -50,6 +54,7 @@ impl Default for SolverOptions {
             rotation_tolerance: 1e-4,
             max_step_translation: 0.04,
             max_step_rotation: 0.05,
+            projector: Matrix3::identity(),
         }
     }
 }
@@ -135,7 +140,10 @@ where
     let mut iterations = 0;
     while iterations < opts.max_iterations && terms.matched > 0 {
         // eq. (3): Δp = −H⁻¹ g (with the absolute, floored Hessian).
-        let step = capped(-solve_absolute(&terms.hessian, &terms.gradient), opts);
+        let step = capped(
+            opts.projector * -solve_absolute(&terms.hessian, &terms.gradient),
+            opts,
+        );
         if small(step, opts) {
             converged = true;
             break;

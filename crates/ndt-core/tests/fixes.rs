@@ -219,7 +219,7 @@ fn corridor_is_degenerate_along_the_corridor_and_a_room_is_not() {
                 &common::urg_scan(&walls, b, 0.005, 2),
                 Pose2::new(0.31, 0.06, 0.11),
                 &MatchOptions {
-                    levels: 4,
+                    levels: Some(4),
                     pair_neighbors: true,
                     ..MatchOptions::default()
                 },

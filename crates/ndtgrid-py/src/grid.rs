@@ -46,7 +46,7 @@ impl PyNdtGrid {
 #[pymethods]
 impl PyNdtGrid {
     #[new]
-    #[pyo3(signature = (cell_size = 0.02, *, levels = 5))]
+    #[pyo3(signature = (cell_size = 0.02, *, levels = 6))]
     fn new(cell_size: f64, levels: i64) -> PyResult<Self> {
         let levels = count("levels", levels)? as usize;
         Ok(Self {
@@ -97,8 +97,8 @@ impl PyNdtGrid {
     /// Matches scan-frame points against the map from `guess`.
     #[pyo3(name = "match", signature = (
         points, guess, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
-        pair_neighbors = true, search_radius = 3, max_iterations = 50, translation_tolerance = 1e-4,
-        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, levels = 5,
+        pair_neighbors = true, search_radius = 1, max_iterations = 50, translation_tolerance = 1e-4,
+        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, freeze_unconstrained = true, levels = None,
         expansion_phases = None
     ))]
     #[allow(clippy::too_many_arguments)]
@@ -117,7 +117,8 @@ impl PyNdtGrid {
         rotation_tolerance: f64,
         max_step_cells: f64,
         max_step_rotation: f64,
-        levels: i64,
+        freeze_unconstrained: bool,
+        levels: Option<i64>,
         expansion_phases: Option<Vec<f64>>,
     ) -> PyResult<PyMatchResult> {
         let options = MatchOptions {
@@ -131,7 +132,8 @@ impl PyNdtGrid {
             rotation_tolerance,
             max_step_cells,
             max_step_rotation,
-            levels: count("levels", levels)?,
+            freeze_unconstrained,
+            levels: levels.map(|l| count("levels", l)).transpose()?,
         };
         let pts = points_arg(points)?;
         let pairs = pts.as_pairs()?;
@@ -152,7 +154,7 @@ impl PyNdtGrid {
     /// Score terms of eq. (1) at `pose` without solving.
     #[pyo3(signature = (
         points, pose, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
-        pair_neighbors = true, search_radius = 3
+        pair_neighbors = true, search_radius = 1
     ))]
     #[allow(clippy::too_many_arguments)]
     fn evaluate<'py>(
@@ -272,6 +274,7 @@ pub fn default_match_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     out.set_item("rotation_tolerance", d.rotation_tolerance)?;
     out.set_item("max_step_cells", d.max_step_cells)?;
     out.set_item("max_step_rotation", d.max_step_rotation)?;
+    out.set_item("freeze_unconstrained", d.freeze_unconstrained)?;
     out.set_item("levels", d.levels)?;
     out.set_item("expansion_phases", py.None())?;
     Ok(out)
