@@ -24,11 +24,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import peers as peer_lib  # noqa: E402
+import peers as peer_lib
 
-import ndtgrid  # noqa: E402
-from ndtgrid.evaluation import corrected_pairs, pose_error  # noqa: E402
-from ndtgrid.io import read_benchmark_index, read_carmen  # noqa: E402
+import ndtgrid
+from ndtgrid.evaluation import corrected_pairs, pose_error
+from ndtgrid.io import read_benchmark_index, read_carmen
 
 REAL = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real"
 LOGS = {
