@@ -38,7 +38,12 @@ LOGS = {
     "MIT CSAIL": ("csail-corrected.log.gz", "mit_csail__csail-corrected__index.csv"),
 }
 MAX_RANGE = 40.0
-PAPER = {"levels": 1, "pair_neighbors": False, "freeze_unconstrained": False, "search_radius": 3}
+PAPER = {
+    "levels": 1,
+    "rotation_search": 0.0,
+    "freeze_unconstrained": False,
+    "search_radius": 3,
+}
 ORIGINAL = {**PAPER, "expansion": 1.0, "neighbor_search": False, "fuse_minority": False}
 
 
@@ -100,15 +105,14 @@ def methods() -> list[peer_lib.Peer]:
         ours(
             "2 cm paper, phased k = 100, 10, 1", 0.02, **PAPER, expansion_phases=[100.0, 10.0, 1.0]
         ),
-        ours("2 cm paper + pyramid 5 levels (to 32 cm)", 0.02, levels=5, pair_neighbors=False),
+        ours("2 cm paper + pyramid (2–64 cm)", 0.02, **{**PAPER, "levels": None}),
         ours(
-            "2 cm pyramid 6 levels + 3×3 pairing, ring search r=3",
+            "  + rotational multi-start ±0.15 rad",
             0.02,
-            search_radius=3,
-            freeze_unconstrained=False,
+            **{**PAPER, "levels": None, "rotation_search": 0.15},
         ),
-        ours("2 cm pyramid 6 levels + 3×3 pairing", 0.02, freeze_unconstrained=False),
-        ours("default match(): + frozen unconstrained directions", 0.02),
+        ours("  + frozen unconstrained directions, r=1 = default match()", 0.02),
+        ours("default + 3×3 pairing", 0.02, pair_neighbors=True),
         ours("16 cm grid, default match() (not 2 cm)", 0.16),
     ]
     return out + peer_lib.all_peers()

@@ -47,9 +47,9 @@ PANELS = [
 MAPS = [
     (
         "paper's method (k = 10, 2 cm)",
-        {"levels": 1, "pair_neighbors": False, "freeze_unconstrained": False, "search_radius": 3},
+        {"levels": 1, "rotation_search": 0.0, "freeze_unconstrained": False, "search_radius": 3},
     ),
-    ("default match() (pyramid, 3×3 pairing)", {}),
+    ("default match()", {}),
 ]
 
 

@@ -21,7 +21,12 @@ from ndtgrid.io import read_benchmark_index, read_carmen
 
 REAL = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real"
 
-PAPER = {"levels": 1, "pair_neighbors": False, "freeze_unconstrained": False, "search_radius": 3}
+PAPER = {
+    "levels": 1,
+    "rotation_search": 0.0,
+    "freeze_unconstrained": False,
+    "search_radius": 3,
+}
 ORIGINAL = {**PAPER, "expansion": 1.0, "neighbor_search": False, "fuse_minority": False}
 SETTINGS = {
     "2 cm, default match() (2–64 cm pyramid, 3×3 pairing, frozen degenerate directions)": (

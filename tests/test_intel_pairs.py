@@ -33,7 +33,12 @@ def pairs() -> list[ndtgrid.evaluation.ScanPair]:
     return out[:N_PAIRS]
 
 
-PAPER = {"levels": 1, "pair_neighbors": False, "freeze_unconstrained": False, "search_radius": 3}
+PAPER = {
+    "levels": 1,
+    "rotation_search": 0.0,
+    "freeze_unconstrained": False,
+    "search_radius": 3,
+}
 
 
 def errors(

@@ -136,13 +136,14 @@ class NdtGrid:
         expansion: float = 10.0,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
-        pair_neighbors: bool = True,
+        pair_neighbors: bool = False,
         search_radius: int = 1,
         max_iterations: int = 50,
         translation_tolerance: float = 1e-4,
         rotation_tolerance: float = 1e-4,
         max_step_cells: float = 2.0,
         max_step_rotation: float = 0.05,
+        rotation_search: float = 0.15,
         freeze_unconstrained: bool = True,
         levels: int | None = None,
         expansion_phases: Sequence[float] | None = None,
@@ -150,14 +151,14 @@ class NdtGrid:
         """Match a scan against the map by Newton's method on eq. (1).
 
         The defaults are the paper's method (§IV-A: k = 10, neighbour search and
-        fusion on) run coarse to fine over the pyramid (2-64 cm on a 2 cm grid)
-        with 3x3 pairing
-        and unconstrained directions frozen: the best setting measured by
-        ``benches/convergence.py`` (BENCHMARK.md). The paper's method alone is
-        ``levels=1, pair_neighbors=False, freeze_unconstrained=False,
-        search_radius=3``; the original NDT of Biber & Strasser on the same
-        grid is additionally ``expansion=1.0, neighbor_search=False,
-        fuse_minority=False``.
+        fusion on) run coarse to fine over the pyramid (2-64 cm on a 2 cm
+        grid), with a rotational multi-start on the coarsest level and the
+        directions the scan does not constrain frozen: the best setting
+        measured by ``benches/convergence.py`` (BENCHMARK.md). The paper's
+        method alone is ``levels=1, rotation_search=0.0,
+        freeze_unconstrained=False, search_radius=3``; the original NDT of
+        Biber & Strasser on the same grid is additionally ``expansion=1.0,
+        neighbor_search=False, fuse_minority=False``.
 
         Parameters
         ----------
@@ -174,16 +175,16 @@ class NdtGrid:
         fuse_minority : bool, default True
             §IV-A(3): a cell with fewer than 3 points takes the distribution of
             the summed eq. (6) terms of itself and its 8 neighbours.
-        pair_neighbors : bool, default True
+        pair_neighbors : bool, default False
             Score each point against every distribution of the 3x3 block of
             cells around it (summed, as Biber's overlapping grids and
             Magnusson's NDT do) instead of its own cell's alone; points with
             none there fall back to the neighbour search. Smooths the score of
             fine cells.
         search_radius : int, default 1
-            Neighbour-search radius [cells], at most 1000. With 3x3 pairing a
-            radius of 1 is the block itself; larger radii measured worse on
-            real scan pairs (points paired with the wrong wall).
+            Neighbour-search radius [cells], at most 1000. Larger radii
+            measured worse on real scan pairs (points get paired with the wrong
+            wall); the pyramid provides the wide basin instead.
         max_iterations : int, default 50
             Newton steps at most.
         translation_tolerance, rotation_tolerance : float, default 1e-4
@@ -193,6 +194,10 @@ class NdtGrid:
             the narrow basin of a fine grid.
         max_step_rotation : float, default 0.05
             Largest rotation per Newton step [rad].
+        rotation_search : float, default 0.15
+            Half-width [rad] of the rotational multi-start of the first
+            (coarsest) stage: it also solves from the guess turned by +/- this
+            angle and keeps the best score; 0 turns it off.
         freeze_unconstrained : bool, default True
             From the second pyramid stage on, project Newton steps onto the
             pose directions the scan constrains (point-to-plane information,
@@ -231,7 +236,7 @@ class NdtGrid:
         expansion: float = 10.0,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
-        pair_neighbors: bool = True,
+        pair_neighbors: bool = False,
         search_radius: int = 1,
     ) -> tuple[float, F64Array, F64Array, int]:
         """Score terms at ``pose`` without solving.

@@ -153,6 +153,9 @@ fn neighbour_search_pairs_a_point_outside_every_cell() {
     );
 }
 
+/// `(M, m, S)` of a naive per-cell sum.
+type Sums = (u64, Vector2<f64>, Matrix2<f64>);
+
 #[test]
 fn pyramid_levels_equal_sums_recomputed_from_scratch() {
     let cell = 0.02;
@@ -175,8 +178,7 @@ fn pyramid_levels_equal_sums_recomputed_from_scratch() {
     }
     for l in 0..6 {
         let size = cell * f64::from(1u32 << l);
-        let mut naive: std::collections::HashMap<(i64, i64), (u64, Vector2<f64>, Matrix2<f64>)> =
-            Default::default();
+        let mut naive: std::collections::HashMap<(i64, i64), Sums> = Default::default();
         for w in &world {
             let k = ((w[0] / size).floor() as i64, (w[1] / size).floor() as i64);
             let e = naive

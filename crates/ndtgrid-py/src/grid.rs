@@ -97,8 +97,9 @@ impl PyNdtGrid {
     /// Matches scan-frame points against the map from `guess`.
     #[pyo3(name = "match", signature = (
         points, guess, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
-        pair_neighbors = true, search_radius = 1, max_iterations = 50, translation_tolerance = 1e-4,
-        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, freeze_unconstrained = true, levels = None,
+        pair_neighbors = false, search_radius = 1, max_iterations = 50, translation_tolerance = 1e-4,
+        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, rotation_search = 0.15, freeze_unconstrained = true,
+        levels = None,
         expansion_phases = None
     ))]
     #[allow(clippy::too_many_arguments)]
@@ -117,6 +118,7 @@ impl PyNdtGrid {
         rotation_tolerance: f64,
         max_step_cells: f64,
         max_step_rotation: f64,
+        rotation_search: f64,
         freeze_unconstrained: bool,
         levels: Option<i64>,
         expansion_phases: Option<Vec<f64>>,
@@ -132,6 +134,7 @@ impl PyNdtGrid {
             rotation_tolerance,
             max_step_cells,
             max_step_rotation,
+            rotation_search,
             freeze_unconstrained,
             levels: levels.map(|l| count("levels", l)).transpose()?,
         };
@@ -154,7 +157,7 @@ impl PyNdtGrid {
     /// Score terms of eq. (1) at `pose` without solving.
     #[pyo3(signature = (
         points, pose, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
-        pair_neighbors = true, search_radius = 1
+        pair_neighbors = false, search_radius = 1
     ))]
     #[allow(clippy::too_many_arguments)]
     fn evaluate<'py>(
@@ -274,6 +277,7 @@ pub fn default_match_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     out.set_item("rotation_tolerance", d.rotation_tolerance)?;
     out.set_item("max_step_cells", d.max_step_cells)?;
     out.set_item("max_step_rotation", d.max_step_rotation)?;
+    out.set_item("rotation_search", d.rotation_search)?;
     out.set_item("freeze_unconstrained", d.freeze_unconstrained)?;
     out.set_item("levels", d.levels)?;
     out.set_item("expansion_phases", py.None())?;
