@@ -53,15 +53,6 @@ fn recover(cell: f64, max_t: f64, max_r_deg: f64, seed: u64, options: &MatchOpti
 #[test]
 fn recovers_synthetic_scan_on_2cm_grid() {
     recover(0.02, 0.05, 1.5, 1, &MatchOptions::default());
-    // The paper's method alone, too.
-    let paper = MatchOptions {
-        levels: Some(1),
-        rotation_search: 0.0,
-        freeze_unconstrained: false,
-        search_radius: 3,
-        ..MatchOptions::default()
-    };
-    recover(0.02, 0.03, 1.0, 3, &paper);
 }
 
 #[test]
