@@ -169,6 +169,37 @@ impl NdtGrid {
         Ok(touched)
     }
 
+    /// Removes the cells `keys` (their eq. (6) sums entirely) from the grid,
+    /// as the §V elimination steps delete false detections. Keys without a
+    /// cell, and repeated keys, are ignored. The prepared distributions are
+    /// updated exactly as [`NdtGrid::insert`] does: a removed cell loses its
+    /// distribution and its minority neighbours (fused sums, §IV-A(3)) are
+    /// recomputed.
+    ///
+    /// Returns the number of cells removed. Cannot fail.
+    pub fn remove_cells(&mut self, keys: &[CellKey]) -> usize {
+        let removed: Vec<CellKey> = keys
+            .iter()
+            .copied()
+            .filter(|key| self.cells.remove(key).is_some())
+            .collect();
+        if removed.is_empty() {
+            return 0;
+        }
+        let cell_size = self.cell_size;
+        let cells = &self.cells;
+        let prepared = self.prepared.get_mut().unwrap_or_else(|e| e.into_inner());
+        for dist in prepared.iter_mut() {
+            Arc::make_mut(dist).update(cells, cell_size, &removed);
+        }
+        removed.len()
+    }
+
+    /// Keys of every occupied cell, in no particular order.
+    pub fn keys(&self) -> impl Iterator<Item = CellKey> + '_ {
+        self.cells.keys().copied()
+    }
+
     /// The distributions for `options`, built on first use and then kept up to
     /// date by [`NdtGrid::insert`].
     pub(crate) fn distributions(&self, options: DistOptions) -> Arc<Distributions> {
