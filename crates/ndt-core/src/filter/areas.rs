@@ -44,6 +44,7 @@ pub fn unconfirmed_small(table: &CellTable) -> Vec<CellKey> {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
     use crate::filter::observation::CellInfo;

@@ -46,6 +46,7 @@ pub fn former_cell_short_of(
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
     use crate::Pose2;

@@ -101,6 +101,7 @@ pub fn forefront_cell(cluster: &[Beam], keep: &[bool], inv_cell_size: f64) -> Op
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
     use crate::Pose2;

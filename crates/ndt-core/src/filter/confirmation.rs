@@ -79,7 +79,7 @@ pub fn passed_cells(
 ) {
     let ray = hit - sensor;
     let range = ray.norm();
-    if !(range > margin) {
+    if range.partial_cmp(&margin) != Some(std::cmp::Ordering::Greater) {
         return;
     }
     let dir = ray / range;
@@ -108,6 +108,7 @@ pub fn passed_cells(
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
     use crate::filter::observation::CellInfo;

@@ -72,6 +72,7 @@ pub fn group_objects(grid: &NdtGrid, keys: &[CellKey]) -> Vec<SmallObject> {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
     use crate::Pose2;

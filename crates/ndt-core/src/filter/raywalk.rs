@@ -70,6 +70,7 @@ pub fn walk_cells(
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 
