@@ -15,8 +15,8 @@ impl PyMapperOptions {
         backshift_rejection = true, observation_check = true, radial_confirmation = true,
         min_range = 0.0, max_range = f64::INFINITY, reliable_range = 0.5, cluster_gap = 0.05,
         cluster_spacing_factor = 2.0, small_object_size = 0.05, behind_com_margin = 0.0,
-        backshift_window = 0.10, check_interval = 3, min_observations = 2,
-        clear_margin = 0.03, pass_radius = 0.005
+        backshift_window = 0.10, check_interval = 3, min_observations = 2, observation_support = true,
+        clear_margin = 0.03, clear_margin_relative = 0.015, pass_radius = 0.005
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -36,7 +36,9 @@ impl PyMapperOptions {
         backshift_window: f64,
         check_interval: i64,
         min_observations: i64,
+        observation_support: bool,
         clear_margin: f64,
+        clear_margin_relative: f64,
         pass_radius: f64,
     ) -> PyResult<Self> {
         let options = MapperOptions {
@@ -56,7 +58,9 @@ impl PyMapperOptions {
             backshift_window,
             check_interval: count("check_interval", check_interval)?,
             min_observations: count("min_observations", min_observations)?,
+            observation_support,
             clear_margin,
+            clear_margin_relative,
             pass_radius,
         };
         options.validate().map_err(to_py)?;
@@ -149,7 +153,9 @@ options_class!(
     backshift_window: f64,
     check_interval: u32,
     min_observations: u32,
+    observation_support: bool,
     clear_margin: f64,
+    clear_margin_relative: f64,
     pass_radius: f64,
 );
 

@@ -89,15 +89,36 @@ pub fn behind_com(cluster: &[Beam], com: Vector2<f64>, margin: f64) -> Vec<bool>
 }
 
 /// §V step a-4: the forefront cell of a cluster: the cell (of size `1 /
-/// inv_cell_size` m) holding the nearest of the points for which `keep` is
-/// `true`. `None` when no point is kept.
+/// inv_cell_size` m) holding the centre of mass of the points for which
+/// `keep` is `true` — after a-3 these are the front part of the object — or,
+/// when no kept point lies in that cell, the cell of the kept point nearest
+/// to it. `None` when no point is kept.
+///
+/// Taking the cell of the single nearest point instead would follow the
+/// range noise: with σ = 5 mm the nearest of ten points lies 1–2σ in front
+/// of the surface, often in the cell in front of it, and a different cell
+/// each scan.
 pub fn forefront_cell(cluster: &[Beam], keep: &[bool], inv_cell_size: f64) -> Option<CellKey> {
-    cluster
+    let kept: Vec<&Beam> = cluster
         .iter()
         .zip(keep)
         .filter(|(_, &k)| k)
-        .min_by(|(a, _), (b, _)| a.range.total_cmp(&b.range))
-        .and_then(|(b, _)| CellKey::of(b.world, inv_cell_size))
+        .map(|(b, _)| b)
+        .collect();
+    if kept.is_empty() {
+        return None;
+    }
+    let com = kept.iter().map(|b| b.world).sum::<Vector2<f64>>() / kept.len() as f64;
+    let key = CellKey::of(com, inv_cell_size)?;
+    if kept
+        .iter()
+        .any(|b| CellKey::of(b.world, inv_cell_size) == Some(key))
+    {
+        return Some(key);
+    }
+    kept.iter()
+        .min_by(|a, b| (a.world - com).norm().total_cmp(&(b.world - com).norm()))
+        .and_then(|b| CellKey::of(b.world, inv_cell_size))
 }
 
 #[cfg(test)]
@@ -149,8 +170,20 @@ mod tests {
         assert_eq!(behind, vec![true, false, false, false, true]);
         let keep: Vec<bool> = behind.iter().map(|x| !x).collect();
         let front = forefront_cell(&b, &keep, 50.0).unwrap();
-        // The nearest kept point is beam 101 (range 1.0; first of the ties).
-        assert_eq!(front, CellKey::of(b[1].world, 50.0).unwrap());
+        // The kept points' centre of mass lies in their cell.
+        let com_kept = (b[1].world + b[2].world + b[3].world) / 3.0;
+        assert_eq!(front, CellKey::of(com_kept, 50.0).unwrap());
+        assert_eq!(front, CellKey::of(b[2].world, 50.0).unwrap());
         assert_eq!(forefront_cell(&b, &[false; 5], 50.0), None);
+    }
+
+    #[test]
+    fn a4_forefront_cell_does_not_follow_one_noisy_point() {
+        // Four points of one surface at ~1.006 m; one reads 9 mm short and
+        // falls into the cell in front (x < 1.00).
+        let b = beams(0, &[1.006, 1.008, 0.997, 1.007]);
+        let front = forefront_cell(&b, &[true; 4], 50.0).unwrap();
+        assert_eq!(front, CellKey { ix: 50, iy: 0 });
+        assert_eq!(CellKey::of(b[2].world, 50.0).unwrap().ix, 49);
     }
 }

@@ -5,21 +5,27 @@
 //! in Area 2 may slip past a thin object); cells of big objects everywhere,
 //! which also removes objects that have moved.
 //!
-//! Two guards keep the walk from eating real surfaces (they are ours, not the
-//! paper's, and documented on [`passed_cells`]):
+//! Three guards keep the walk from eating real surfaces (they are ours, not
+//! the paper's):
 //! - a cell counts as passed only when the beam passes within `pass_radius`
 //!   of the mean of its points (a 2 cm cell is wider than a 1.5 cm stick;
 //!   a beam through the cell beside the stick has not shown it is gone);
 //! - the walk stops `margin` short of the hit, and more at grazing incidence
-//!   ([`grazing_margin`]), where the beam runs along the very wall it hits.
+//!   ([`grazing_margin`]), where the beam runs along the very wall it hits;
+//! - a small-object cell is removed only when one scan's beams pass its mean
+//!   on both sides ([`cells_to_clear`]): the mean lies on the object's
+//!   surface, so a beam that just misses the object from another side passes
+//!   close to it on one side only.
 
 use nalgebra::Vector2;
+use rustc_hash::FxHashMap;
 
 use crate::filter::areas::Area;
 use crate::filter::observation::CellTable;
 use crate::filter::raywalk::walk_cells;
 use crate::filter::Beam;
 use crate::grid::NdtGrid;
+use crate::key::CellKey;
 
 /// How many points on each side of a hit estimate the surface direction.
 const TANGENT_SPAN: usize = 3;
@@ -63,6 +69,18 @@ pub struct Clearing {
     pub reliable_range: f64,
 }
 
+/// One beam passing a map cell (see [`passed_cells`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pass {
+    /// The cell passed.
+    pub key: CellKey,
+    /// The cell belongs to a small object.
+    pub small: bool,
+    /// The side of the beam the cell's mean lies on (`true`: left, i.e.
+    /// counter-clockwise).
+    pub left: bool,
+}
+
 /// §V step d for one beam from `sensor` to `hit` (map frame [m]): appends to
 /// `out` the map cells the beam passed through short of its hit — every cell
 /// the walk crosses up to `margin` [m] before the hit whose point mean lies
@@ -75,7 +93,7 @@ pub fn passed_cells(
     hit: Vector2<f64>,
     margin: f64,
     clearing: Clearing,
-    out: &mut Vec<crate::CellKey>,
+    out: &mut Vec<Pass>,
 ) {
     let ray = hit - sensor;
     let range = ray.norm();
@@ -95,16 +113,42 @@ pub fn passed_cells(
         let mean = key.center(cell_size) + stats.sum / stats.count as f64;
         let rel = mean - sensor;
         let along = rel.dot(&dir);
-        let across = (rel - dir * along).norm();
-        if along <= 0.0 || along >= reach || across > clearing.pass_radius {
+        let side = dir.x * rel.y - dir.y * rel.x;
+        if along <= 0.0 || along >= reach || side.abs() > clearing.pass_radius {
             return true;
         }
         let small = table.get(&key).is_some_and(|c| c.is_small());
         if !small || Area::of(rel.norm(), clearing.reliable_range) == Area::Reliable {
-            out.push(key);
+            out.push(Pass {
+                key,
+                small,
+                left: side > 0.0,
+            });
         }
         true
     });
+}
+
+/// §V step d for a whole scan: the cells to remove given every beam's
+/// passes. A big-object cell goes when any beam passed it; a small-object
+/// cell only when beams passed its mean on both sides. Sorted, no repeats.
+pub fn cells_to_clear(passes: &[Pass]) -> Vec<CellKey> {
+    let mut sides: FxHashMap<CellKey, (bool, bool, bool)> = FxHashMap::default();
+    for p in passes {
+        let e = sides.entry(p.key).or_insert((p.small, false, false));
+        if p.left {
+            e.1 = true;
+        } else {
+            e.2 = true;
+        }
+    }
+    let mut out: Vec<CellKey> = sides
+        .into_iter()
+        .filter(|(_, (small, left, right))| !small || (*left && *right))
+        .map(|(k, _)| k)
+        .collect();
+    out.sort_unstable();
+    out
 }
 
 #[cfg(test)]
@@ -112,7 +156,7 @@ pub fn passed_cells(
 mod tests {
     use super::*;
     use crate::filter::observation::CellInfo;
-    use crate::{CellKey, Pose2};
+    use crate::Pose2;
 
     fn setup() -> (NdtGrid, CellTable) {
         let mut grid = NdtGrid::new(0.02).unwrap();
@@ -145,7 +189,24 @@ mod tests {
             &mut out,
         );
         let key = |x: f64| CellKey::of(Vector2::new(x, 0.001), 50.0).unwrap();
-        assert_eq!(out, vec![key(0.301), key(0.401)]);
+        let keys: Vec<CellKey> = out.iter().map(|p| p.key).collect();
+        assert_eq!(keys, vec![key(0.301), key(0.401)]);
+        assert_eq!(
+            out.iter().map(|p| (p.small, p.left)).collect::<Vec<_>>(),
+            vec![(false, true), (true, true)]
+        );
+        // One pass clears the big cell; the small one needs both sides.
+        assert_eq!(cells_to_clear(&out), vec![key(0.301)]);
+        passed_cells(
+            &grid,
+            &table,
+            Vector2::new(0.0, 0.004),
+            Vector2::new(2.0, 0.004),
+            0.04,
+            clearing,
+            &mut out,
+        );
+        assert_eq!(cells_to_clear(&out), vec![key(0.301), key(0.401)]);
         // From farther back the small cell at 0.4 m is in Area 2 too.
         out.clear();
         passed_cells(
@@ -157,7 +218,10 @@ mod tests {
             clearing,
             &mut out,
         );
-        assert_eq!(out, vec![key(0.301)]);
+        assert_eq!(
+            out.iter().map(|p| p.key).collect::<Vec<_>>(),
+            vec![key(0.301)]
+        );
     }
 
     #[test]

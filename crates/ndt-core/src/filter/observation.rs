@@ -4,6 +4,12 @@
 //! every third scan), the cells seen in fewer than `min_observations` scans
 //! are deleted. This file also holds the per-cell bookkeeping the other
 //! steps read ([`CellInfo`]).
+//!
+//! With `support` (ours, on by default) a rarely seen cell is kept when one
+//! of its 8 neighbours is established (seen in at least `min_observations`
+//! scans): at 2 cm a far wall is hit sparsely and each of its cells may be
+//! hit in a single scan while the wall as a whole is seen in every scan;
+//! speckle, by contrast, lies off the surface, away from established cells.
 
 use rustc_hash::FxHashMap;
 
@@ -80,18 +86,30 @@ pub fn check_due(scan: u64, interval: u32) -> bool {
 
 /// §V step c: the cells that scan `scan`'s check deletes: those that have
 /// had at least `interval` scans to be observed (first seen `interval − 1` or
-/// more scans ago) and were observed in fewer than `min_observations` scans.
-/// Sorted, so results are deterministic.
+/// more scans ago) and were observed in fewer than `min_observations` scans
+/// — with `support`, only those without an established 8-neighbour. Sorted,
+/// so results are deterministic.
 pub fn rarely_seen(
     table: &CellTable,
     scan: u64,
     interval: u32,
     min_observations: u32,
+    support: bool,
 ) -> Vec<CellKey> {
+    let established = |k: CellKey| {
+        table
+            .get(&k)
+            .is_some_and(|c| c.observations >= min_observations)
+    };
+    let supported = |k: CellKey| {
+        (-1..=1).any(|dy| (-1..=1).any(|dx| (dx, dy) != (0, 0) && established(k.offset(dx, dy))))
+    };
     let mut out: Vec<CellKey> = table
         .iter()
-        .filter(|(_, c)| {
-            scan + 1 >= c.first_seen + u64::from(interval) && c.observations < min_observations
+        .filter(|(&k, c)| {
+            scan + 1 >= c.first_seen + u64::from(interval)
+                && c.observations < min_observations
+                && !(support && supported(k))
         })
         .map(|(&k, _)| k)
         .collect();
@@ -107,9 +125,14 @@ mod tests {
     #[test]
     fn c_deletes_cells_seen_once_after_a_full_window() {
         let mut table = CellTable::default();
-        let key = |i| CellKey { ix: i, iy: 0 };
+        let key = |i| CellKey { ix: 3 * i, iy: 0 };
         // Cell 0: a wall seen in scans 1, 2, 3. Cell 1: speckle in scan 1.
         // Cell 2: new in scan 3 (too young to judge at scan 3).
+        let next_to_wall = CellKey { ix: 1, iy: 1 };
+        table
+            .entry(next_to_wall)
+            .or_insert(CellInfo::new(1))
+            .observe(1, false, false);
         for scan in 1..=3 {
             table
                 .entry(key(0))
@@ -125,9 +148,17 @@ mod tests {
             .or_insert(CellInfo::new(3))
             .observe(3, false, false);
         assert!(!check_due(2, 3) && check_due(3, 3) && check_due(6, 3));
-        assert_eq!(rarely_seen(&table, 3, 3, 2), vec![key(1)]);
+        assert_eq!(
+            rarely_seen(&table, 3, 3, 2, false),
+            vec![next_to_wall, key(1)]
+        );
         // At scan 6 cell 2 has had scans 3..6 and was seen once: deleted.
-        assert_eq!(rarely_seen(&table, 6, 3, 2), vec![key(1), key(2)]);
+        assert_eq!(
+            rarely_seen(&table, 6, 3, 2, false),
+            vec![next_to_wall, key(1), key(2)]
+        );
+        // With support, the cell next to the established wall cell stays.
+        assert_eq!(rarely_seen(&table, 6, 3, 2, true), vec![key(1), key(2)]);
     }
 
     #[test]

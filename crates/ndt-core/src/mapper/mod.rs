@@ -100,6 +100,7 @@ impl MapFilter {
                 self.scans,
                 self.options.check_interval,
                 self.options.min_observations,
+                self.options.observation_support,
             );
             let n = self.delete(grid, &keys);
             self.counts.observation_cells += n as u64;

@@ -9,7 +9,7 @@ use crate::error::{check_finite, NdtError, Result};
 use crate::filter::areas::Area;
 use crate::filter::backshift::former_cell_short_of;
 use crate::filter::cluster::{behind_com, centre_of_mass, clusters, forefront_cell, is_small};
-use crate::filter::confirmation::{grazing_margin, passed_cells, Clearing};
+use crate::filter::confirmation::{cells_to_clear, grazing_margin, passed_cells, Clearing};
 use crate::filter::observation::{check_due, CellInfo};
 use crate::filter::Beam;
 use crate::grid::NdtGrid;
@@ -112,6 +112,7 @@ impl MapFilter {
         // against the map as it was before this scan).
         let mut clear: Vec<CellKey> = Vec::new();
         if o.radial_confirmation {
+            let mut passes = Vec::new();
             let clearing = Clearing {
                 pass_radius: o.pass_radius,
                 reliable_range: o.reliable_range,
@@ -120,7 +121,8 @@ impl MapFilter {
                 let cluster = &beams[g.clone()];
                 for (j, beam) in cluster.iter().enumerate() {
                     if keep[g.start + j] {
-                        let margin = grazing_margin(cluster, j, sensor, o.clear_margin);
+                        let base = o.clear_margin.max(o.clear_margin_relative * beam.range);
+                        let margin = grazing_margin(cluster, j, sensor, base);
                         passed_cells(
                             grid,
                             &self.table,
@@ -128,15 +130,14 @@ impl MapFilter {
                             beam.world,
                             margin,
                             clearing,
-                            &mut clear,
+                            &mut passes,
                         );
                     }
                 }
             }
+            clear = cells_to_clear(&passes);
             // A cell hit by this scan is not free space.
             clear.retain(|k| !hit_set.contains(k));
-            clear.sort_unstable();
-            clear.dedup();
         }
         // Cells in the grid that the filter has not seen (inserted into the
         // grid directly) count as established when first hit.
