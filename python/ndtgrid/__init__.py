@@ -18,7 +18,11 @@ Examples
 
 from __future__ import annotations
 
-from ndtgrid import io, se2
+from ndtgrid import (
+    io,
+    se2,
+    sim,
+)
 from ndtgrid._core import (
     Mapper,
     MapperOptions,
@@ -31,7 +35,6 @@ from ndtgrid._core import (
     default_match_options,
     ranges_to_points,
 )
-from ndtgrid import sim  # noqa: E402  (after se2, which it uses)
 
 __all__ = [
     "Mapper",

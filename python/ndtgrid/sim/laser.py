@@ -45,7 +45,9 @@ F64 = npt.NDArray[np.float64]
 I64 = npt.NDArray[np.int64]
 
 
-def cast_rays(world: World, origin: npt.ArrayLike, directions: F64, *, sticks: bool = True) -> tuple[F64, I64]:
+def cast_rays(
+    world: World, origin: npt.ArrayLike, directions: F64, *, sticks: bool = True
+) -> tuple[F64, I64]:
     """Nearest intersection of rays from one origin with the world's surfaces.
 
     Parameters
@@ -247,7 +249,8 @@ class Laser:
         if self.backshift > 0 and on_stick.any():
             axis_dir = np.stack([np.cos(th + angles), np.sin(th + angles)], axis=-1)
             behind, _ = cast_rays(world, (x, y), axis_dir, sticks=False)
-            gap = behind - r_cov
+            with np.errstate(invalid="ignore"):
+                gap = np.where(on_stick, behind - r_cov, np.inf)
             shifted = on_stick & (r_cov > self.reliable_range) & (gap <= self.backshift_reach)
             ranges[shifted] = np.minimum(ranges[shifted] + self.backshift, behind[shifted])
 

@@ -81,11 +81,22 @@ pub fn centre_of_mass(cluster: &[Beam]) -> Vector2<f64> {
 }
 
 /// §V step a-3: `true` for each point that lies behind the centre of mass
-/// `com` (sensor frame): its range exceeds the distance of `com` from the
-/// sensor by more than `margin` [m].
+/// `com` (sensor frame): farther than `com` along the bearing of `com` by
+/// more than `margin` [m] (plus 1 nm against round-off). Measuring along the
+/// bearing rather than by range keeps a cluster whose points lie at one
+/// range whole (their mean lies inside the arc, nearer than any of them) and
+/// never drops every point: the projections average exactly to `|com|`.
 pub fn behind_com(cluster: &[Beam], com: Vector2<f64>, margin: f64) -> Vec<bool> {
-    let limit = com.norm() + margin;
-    cluster.iter().map(|b| b.range > limit).collect()
+    let norm = com.norm();
+    if norm == 0.0 {
+        return vec![false; cluster.len()];
+    }
+    let bearing = com / norm;
+    let limit = norm + margin + 1e-9;
+    cluster
+        .iter()
+        .map(|b| b.local.dot(&bearing) > limit)
+        .collect()
 }
 
 /// §V step a-4: the forefront cell of a cluster: the cell (of size `1 /
@@ -175,6 +186,23 @@ mod tests {
         assert_eq!(front, CellKey::of(com_kept, 50.0).unwrap());
         assert_eq!(front, CellKey::of(b[2].world, 50.0).unwrap());
         assert_eq!(forefront_cell(&b, &[false; 5], 50.0), None);
+    }
+
+    #[test]
+    fn a3_never_drops_a_whole_cluster() {
+        // Five points at exactly 0.41 m: their mean lies 0.01 mm nearer than
+        // any of them, so by range all five would be behind it; along its
+        // bearing only the middle three are (the projections average to it).
+        let b = beams(0, &[0.41; 5]);
+        let com = centre_of_mass(&b);
+        assert!(b.iter().all(|p| p.range > com.norm()));
+        assert_eq!(
+            behind_com(&b, com, 0.0),
+            vec![false, true, true, true, false]
+        );
+        assert_eq!(behind_com(&b, com, 0.001), vec![false; 5]);
+        let one = beams(7, &[1.234]);
+        assert_eq!(behind_com(&one, centre_of_mass(&one), 0.0), vec![false]);
     }
 
     #[test]
