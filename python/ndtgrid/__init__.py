@@ -3,8 +3,10 @@
 A Rust core (``ndtgrid._core``) implements Takubo et al., "NDT Scan Matching
 Method for High Resolution Grid Map" (IROS 2009): a sparse grid whose cells
 keep only the sums of eq. (6), Newton scan matching on the score of eq. (1),
-and the small-cell fixes of §IV-A. Units are metres and radians; poses are
+the small-cell fixes of §IV-A, and the elimination of false detections of
+§V (:class:`Mapper`). Units are metres and radians; poses are
 ``[x, y, theta]`` arrays that map scan-frame points into the map frame.
+:mod:`ndtgrid.sim` is a small laser simulator for tests and demos.
 
 Examples
 --------
@@ -16,7 +18,36 @@ Examples
 
 from __future__ import annotations
 
-from ndtgrid import io, se2
-from ndtgrid._core import MatchResult, NdtGrid, __version__, default_match_options
+from ndtgrid import (
+    io,
+    se2,
+    sim,
+)
+from ndtgrid._core import (
+    Mapper,
+    MapperOptions,
+    MatchResult,
+    NdtGrid,
+    RemovalCounts,
+    SmallObject,
+    __version__,
+    default_mapper_options,
+    default_match_options,
+    ranges_to_points,
+)
 
-__all__ = ["MatchResult", "NdtGrid", "__version__", "default_match_options", "io", "se2"]
+__all__ = [
+    "Mapper",
+    "MapperOptions",
+    "MatchResult",
+    "NdtGrid",
+    "RemovalCounts",
+    "SmallObject",
+    "__version__",
+    "default_mapper_options",
+    "default_match_options",
+    "io",
+    "ranges_to_points",
+    "se2",
+    "sim",
+]

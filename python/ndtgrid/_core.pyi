@@ -277,6 +277,337 @@ class NdtGrid:
             ``S = sum x x^T`` [m^2].
         """
 
+class MapperOptions:
+    """Options of :class:`Mapper`: the elimination of false detections of §V; frozen.
+
+    Keyword-only; the defaults are the paper's values where it gives them. Every
+    step can be switched off alone; ``outlier_filter=False`` switches all of them
+    off (the unfiltered map). The clustering of step a-1 always runs while the
+    filter is on, because b-1, b-2 and d need to know which clusters are small.
+
+    Parameters
+    ----------
+    outlier_filter : bool, default True
+        Master switch for all of §V.
+    edge_removal : bool, default True
+        Steps a-2 to a-4 (§V-B(1), "edge of object"): in each small cluster of a
+        new scan, drop the points behind its centre of mass (mixed returns land
+        behind a thin object's edges) and keep only its forefront cell (the cell
+        holding the centre of mass of the remaining points).
+    area1_confirmation : bool, default True
+        Step b-1 (§V-B(2)): at each periodic check, delete the cells of small
+        objects never observed from Area 1 (within ``reliable_range``).
+    backshift_rejection : bool, default True
+        Step b-2 (§V-B(2)): do not store a point of a small cluster in Area 2 when
+        the map already holds a cell within ``backshift_window`` short of it along
+        its beam (beyond the reliable range a thin object in front of a wall is
+        measured shifted backward).
+    observation_check : bool, default True
+        Step c (§V-B(3), "surface of wall"): at each periodic check, delete cells
+        observed in fewer than ``min_observations`` scans once they have had
+        ``check_interval`` scans to be seen.
+    radial_confirmation : bool, default True
+        Step d (§V-B(4)): walk each new beam from the sensor to its hit and remove
+        the map cells it passed through (free space now): cells of small objects
+        only within the reliable range, big ones everywhere (which also removes
+        objects that moved).
+    min_range : float, default 0.0
+        Ranges below it are invalid [m].
+    max_range : float, default inf
+        Ranges at or above it are invalid, "no return" [m].
+    reliable_range : float, default 0.5
+        Area 1 / Area 2 boundary [m] (the paper: 0.5 m for 2 cm objects and a
+        URG-04LX).
+    cluster_gap : float, default 0.05
+        a-1: consecutive points at most this far apart [m], plus
+        ``cluster_spacing_factor`` times the spacing of adjacent beams at their
+        range, belong to one cluster.
+    cluster_spacing_factor : float, default 2.0
+        a-1: see ``cluster_gap``.
+    small_object_size : float, default 0.05
+        a-1: a cluster whose extent across the beam is at most this [m] is a
+        small (sub-grid) object.
+    behind_com_margin : float, default 0.0
+        a-3: points more than this [m] behind the centre of mass are dropped.
+    backshift_window : float, default 0.10
+        b-2: how far short of a new point a former cell rejects it [m] (the
+        paper measured a 5 cm shift).
+    check_interval : int, default 3
+        b-1/c: the periodic check runs every this many scans (the paper: 3).
+    min_observations : int, default 2
+        c: fewest scans a cell must have been observed in.
+    observation_support : bool, default True
+        c: keep a rarely seen cell that has an established 8-neighbour (seen in
+        at least ``min_observations`` scans): a sparsely hit far wall is not
+        speckle. Not in the paper.
+    clear_margin : float, default 0.03
+        d: the walk stops this far [m] short of the hit (or
+        ``clear_margin_relative`` times the range if more), divided by
+        ``tan(a)`` at grazing angles ``a < 45 deg`` between beam and surface.
+    clear_margin_relative : float, default 0.015
+        d: see ``clear_margin`` (three standard deviations of a URG-04LX beyond
+        1 m).
+    pass_radius : float, default 0.005
+        d: a cell counts as passed only if the beam passes within this distance
+        [m] of the mean of its points; a small object's cell needs beams on both
+        sides of it in one scan.
+
+    Raises
+    ------
+    ValueError
+        If a length is negative or not finite, ``max_range <= min_range``, or an
+        interval or count is 0.
+    TypeError
+        For an unknown option.
+    """
+
+    def __init__(
+        self,
+        *,
+        outlier_filter: bool = True,
+        edge_removal: bool = True,
+        area1_confirmation: bool = True,
+        backshift_rejection: bool = True,
+        observation_check: bool = True,
+        radial_confirmation: bool = True,
+        min_range: float = 0.0,
+        max_range: float = ...,
+        reliable_range: float = 0.5,
+        cluster_gap: float = 0.05,
+        cluster_spacing_factor: float = 2.0,
+        small_object_size: float = 0.05,
+        behind_com_margin: float = 0.0,
+        backshift_window: float = 0.10,
+        check_interval: int = 3,
+        min_observations: int = 2,
+        observation_support: bool = True,
+        clear_margin: float = 0.03,
+        clear_margin_relative: float = 0.015,
+        pass_radius: float = 0.005,
+    ) -> None: ...
+    @property
+    def outlier_filter(self) -> bool: ...
+    @property
+    def edge_removal(self) -> bool: ...
+    @property
+    def area1_confirmation(self) -> bool: ...
+    @property
+    def backshift_rejection(self) -> bool: ...
+    @property
+    def observation_check(self) -> bool: ...
+    @property
+    def radial_confirmation(self) -> bool: ...
+    @property
+    def min_range(self) -> float: ...
+    @property
+    def max_range(self) -> float: ...
+    @property
+    def reliable_range(self) -> float: ...
+    @property
+    def cluster_gap(self) -> float: ...
+    @property
+    def cluster_spacing_factor(self) -> float: ...
+    @property
+    def small_object_size(self) -> float: ...
+    @property
+    def behind_com_margin(self) -> float: ...
+    @property
+    def backshift_window(self) -> float: ...
+    @property
+    def check_interval(self) -> int: ...
+    @property
+    def min_observations(self) -> int: ...
+    @property
+    def observation_support(self) -> bool: ...
+    @property
+    def clear_margin(self) -> float: ...
+    @property
+    def clear_margin_relative(self) -> float: ...
+    @property
+    def pass_radius(self) -> float: ...
+    def as_dict(self) -> dict[str, Any]:
+        """Every option by name, in the order above."""
+    def replace(self, **changes: Any) -> MapperOptions:
+        """A copy with some options changed (like :func:`dataclasses.replace`)."""
+
+class SmallObject:
+    """A small (sub-grid scale) object detected by :class:`Mapper`; frozen.
+
+    Attributes
+    ----------
+    center : ndarray, shape (2,)
+        Centre of mass of the object's points [m]: ``sum m / sum M`` over its
+        cells (eq. 6 sums), as the paper evaluates its Fig. 8.
+    cells : ndarray, shape (K, 2)
+        Centres of its cells [m], sorted by cell index. Small-object cells that
+        touch (8-neighbourhood) form one object.
+    num_points : int
+        Points in its cells.
+    """
+
+    @property
+    def center(self) -> F64Array: ...
+    @property
+    def cells(self) -> F64Array: ...
+    @property
+    def num_points(self) -> int: ...
+
+class RemovalCounts:
+    """What each §V step of a :class:`Mapper` removed so far; frozen.
+
+    Steps a-3, a-4 and b-2 drop points of a new scan before they reach the map:
+    for them both the points and the cells they would have created (distinct
+    cells of the dropped points not in the map after their scan) are counted.
+    Steps b-1, c and d delete cells of the map. Counts are cumulative: a cell
+    deleted, observed again and deleted again counts twice.
+
+    Attributes
+    ----------
+    behind_com_points, behind_com_cells : int
+        a-3: behind the centre of mass of a small cluster.
+    forefront_points, forefront_cells : int
+        a-4: outside the forefront cell of a small cluster.
+    area1_cells : int
+        b-1: small-object cells never observed from Area 1.
+    backshift_points, backshift_cells : int
+        b-2: small-cluster points in Area 2 behind a former cell.
+    observation_cells : int
+        c: cells observed in too few scans.
+    confirmation_cells : int
+        d: cells passed through by a newer beam.
+    """
+
+    @property
+    def behind_com_points(self) -> int: ...
+    @property
+    def behind_com_cells(self) -> int: ...
+    @property
+    def forefront_points(self) -> int: ...
+    @property
+    def forefront_cells(self) -> int: ...
+    @property
+    def area1_cells(self) -> int: ...
+    @property
+    def backshift_points(self) -> int: ...
+    @property
+    def backshift_cells(self) -> int: ...
+    @property
+    def observation_cells(self) -> int: ...
+    @property
+    def confirmation_cells(self) -> int: ...
+    def as_dict(self) -> dict[str, int]:
+        """Every counter by name, in step order (a-3, a-4, b-1, b-2, c, d)."""
+
+class Mapper:
+    """An :class:`NdtGrid` fed scan by scan through the elimination of §V.
+
+    The map a robot navigates with and matches against: laser scans go in as
+    ranges and angles, the false detections of sub-grid objects (mixed returns
+    behind edges, thin objects in front of walls shifted backward), wall speckle
+    and objects that have moved are kept out or removed, and the small objects
+    (chair legs, poles) come out with their centres.
+
+    Parameters
+    ----------
+    cell_size : float, default 0.02
+        Side of the square cells [m] (the paper: 2 cm).
+    outlier_filter : bool, default True
+        ``False`` stores every valid point and removes nothing (for comparison).
+    **options
+        Any field of :class:`MapperOptions` by keyword.
+
+    Raises
+    ------
+    ValueError
+        If ``cell_size`` or an option is out of range.
+    TypeError
+        For an unknown option.
+
+    Notes
+    -----
+    :attr:`grid` is the same map, not a copy: matching against it sees every
+    insert and removal. Inserting into it directly bypasses the filter (such
+    cells count as established, big objects). Thread safety: any number of
+    threads may read (``grid.match``, :meth:`occupied_cells`, ...) while no
+    scan is being inserted; :meth:`insert_scan` runs alone. The GIL is released
+    while the core works. A failed call leaves the map and the filter unchanged.
+
+    Examples
+    --------
+    >>> import numpy as np, ndtgrid
+    >>> mapper = ndtgrid.Mapper(cell_size=0.02)
+    >>> angles = np.radians(np.arange(-90.0, 90.5, 0.5))
+    >>> mapper.insert_scan(np.full(angles.shape, 2.0), angles, [0.0, 0.0, 0.0])
+    >>> mapper.occupied_cells().shape[1], len(mapper.grid) == len(mapper)
+    (2, True)
+    """
+
+    def __init__(
+        self, cell_size: float = 0.02, *, outlier_filter: bool = True, **options: Any
+    ) -> None: ...
+    @property
+    def grid(self) -> NdtGrid:
+        """The map matched against: an :class:`NdtGrid` sharing this mapper's cells."""
+    @property
+    def options(self) -> MapperOptions:
+        """The options in force."""
+    @property
+    def cell_size(self) -> float:
+        """Cell size [m]."""
+    @property
+    def scan_count(self) -> int:
+        """Scans inserted so far."""
+    def __len__(self) -> int:
+        """Number of occupied cells."""
+    def insert_scan(self, ranges: ArrayLike, angles: ArrayLike, pose: ArrayLike) -> None:
+        """Add one laser scan through the elimination of §V.
+
+        Per scan: a-1 cluster the valid beams in beam order; a-2/a-3 in small
+        clusters drop the points behind the centre of mass; a-4 keep only their
+        forefront cell; b-2 drop small-cluster points in Area 2 lying behind a
+        former cell along their beam; store the rest (eq. 6); d remove the cells
+        the kept beams passed through; every ``check_interval``-th scan, b-1 and
+        c delete cells (see :class:`MapperOptions`).
+
+        Parameters
+        ----------
+        ranges : array_like, shape (B,)
+            Ranges [m]. Beams whose range is 0, NaN, infinite, below
+            ``min_range`` or at or above ``max_range`` are skipped.
+        angles : array_like, shape (B,)
+            Beam angles in the sensor frame [rad], in beam order (clustering
+            follows it); must be finite.
+        pose : array_like, shape (3,)
+            Sensor pose ``[x, y, theta]`` (m, m, rad) in the map frame.
+
+        Raises
+        ------
+        TypeError
+            If an argument is not array-like or holds non-real numbers.
+        ValueError
+            On a wrong shape, lengths that differ, a non-finite angle or pose, or
+            a hit whose cell index would overflow. Nothing changes on error.
+        """
+    def occupied_cells(self) -> F64Array:
+        """Centres of the cells the map keeps as occupied, shape (K, 2) [m], sorted by index."""
+    def small_objects(self) -> list[SmallObject]:
+        """The detected small objects, sorted by their smallest cell index."""
+    def removal_counts(self) -> RemovalCounts:
+        """What each step removed so far."""
+    def run_checks(self) -> int:
+        """Run the periodic checks (b-1, then c) now, e.g. after the last scan.
+
+        Cells too young for step c are left alone.
+
+        Returns
+        -------
+        int
+            Cells deleted.
+        """
+
+def default_mapper_options() -> dict[str, Any]:
+    """The core's defaults for :class:`MapperOptions`."""
+
 def default_match_options() -> dict[str, Any]:
     """The core's defaults for :meth:`NdtGrid.match`."""
 

@@ -195,6 +195,36 @@ impl NdtGrid {
         Ok(touched.into_iter().next().unwrap_or_default())
     }
 
+    /// Removes the cells `keys` (their eq. (6) sums entirely) from the grid,
+    /// as the §V elimination steps delete false detections. Keys without a
+    /// cell, and repeated keys, are ignored. The coarser pyramid levels lose
+    /// the removed sums too, and the prepared distributions are updated
+    /// exactly as [`NdtGrid::insert`] does: a removed cell loses its
+    /// distribution and its minority neighbours (fused sums, §IV-A(3)) are
+    /// recomputed.
+    ///
+    /// Returns the number of cells removed. Cannot fail.
+    pub fn remove_cells(&mut self, keys: &[CellKey]) -> usize {
+        let touched = self.pyramid.remove(keys);
+        let removed = touched.first().map_or(0, Vec::len);
+        if removed == 0 {
+            return 0;
+        }
+        let prepared = self.prepared.get_mut().unwrap_or_else(|e| e.into_inner());
+        for dist in prepared.iter_mut() {
+            let l = dist.level();
+            if let (Some(level), Some(keys)) = (self.pyramid.level(l), touched.get(l)) {
+                Arc::make_mut(dist).update(level.cells(), level.cell_size(), keys);
+            }
+        }
+        removed
+    }
+
+    /// Keys of every occupied cell, in no particular order.
+    pub fn keys(&self) -> impl Iterator<Item = CellKey> + '_ {
+        self.fine().keys().copied()
+    }
+
     /// The distributions of pyramid level `level` for `options`, built on
     /// first use and then kept up to date by [`NdtGrid::insert`]. `None` for a
     /// level the grid does not have.

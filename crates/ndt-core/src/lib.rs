@@ -8,7 +8,10 @@
 //! - [`NdtGrid`]: cells keep `M, m, S` (eq. 6) and give eq. (7) distributions;
 //! - [`NdtGrid::match_scan`]: Newton's method on the score of eq. (1) with
 //!   analytic per-point gradient and Hessian (eq. 3–5) and the small-cell fixes
-//!   of §IV-A (neighbour search, expansion by `k` of eq. 8, minority fusion).
+//!   of §IV-A (neighbour search, expansion by `k` of eq. 8, minority fusion);
+//! - [`Mapper`] / [`MapFilter`]: the elimination of false detections of §V
+//!   (sub-grid objects, wall speckle, moved objects) in front of the grid,
+//!   one step per file under [`filter`].
 //!
 //! Units: metres and radians. Poses are `T_map_scan` (see [`Pose2`]).
 #![deny(missing_docs)]
@@ -18,9 +21,11 @@ pub mod cell;
 pub mod degeneracy;
 pub mod distributions;
 pub mod error;
+pub mod filter;
 pub mod grid;
 pub mod information;
 pub mod key;
+pub mod mapper;
 pub mod matcher;
 pub mod neighbor;
 pub mod pyramid;
@@ -31,8 +36,10 @@ pub mod solver;
 
 pub use cell::{CellStats, Gaussian};
 pub use error::{NdtError, Result};
+pub use filter::objects::SmallObject;
 pub use grid::{CellRecord, NdtGrid};
 pub use key::CellKey;
+pub use mapper::{MapFilter, Mapper, MapperOptions, RemovalCounts};
 pub use matcher::{MatchOptions, MatchResult};
 pub use nalgebra;
 pub use ranges::points_from_ranges;

@@ -120,3 +120,56 @@ impl Pyramid {
         touched_all
     }
 }
+
+impl Pyramid {
+    /// Removes the fine cells `keys` and their sums from every coarser level.
+    /// A coarse cell is recomputed as the sum of its 4 children on the level
+    /// below (exact, no subtraction drift), and dropped when they are all gone.
+    ///
+    /// Returns, per level, the keys of the cells that changed (level 0: the
+    /// fine cells actually removed).
+    pub fn remove(&mut self, keys: &[CellKey]) -> Vec<Vec<CellKey>> {
+        let mut touched_all: Vec<Vec<CellKey>> = Vec::with_capacity(self.levels.len());
+        let mut seen = FxHashSet::default();
+        let mut removed = Vec::new();
+        for &key in keys {
+            if seen.insert(key) && self.levels[0].cells.remove(&key).is_some() {
+                removed.push(key);
+            }
+        }
+        touched_all.push(removed);
+        for l in 1..self.levels.len() {
+            let mut parents = FxHashSet::default();
+            let mut changed = Vec::new();
+            for &child in &touched_all[l - 1] {
+                let parent = coarse_key(child, 1);
+                if parents.insert(parent) {
+                    changed.push(parent);
+                }
+            }
+            let (below, above) = self.levels.split_at_mut(l);
+            let (lower, upper) = (&below[l - 1], &mut above[0]);
+            for &parent in &changed {
+                let mut sum = CellStats::default();
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let child = CellKey {
+                        ix: parent.ix * 2 + dx,
+                        iy: parent.iy * 2 + dy,
+                    };
+                    if let Some(s) = lower.cells.get(&child) {
+                        // Children's sums are about their own centres.
+                        let delta = parent.center(upper.cell_size) - child.center(lower.cell_size);
+                        sum.merge(&s.shifted(delta));
+                    }
+                }
+                if sum.count == 0 {
+                    upper.cells.remove(&parent);
+                } else {
+                    upper.cells.insert(parent, sum);
+                }
+            }
+            touched_all.push(changed);
+        }
+        touched_all
+    }
+}

@@ -157,7 +157,7 @@ fn neighbour_search_pairs_a_point_outside_every_cell() {
 type Sums = (u64, Vector2<f64>, Matrix2<f64>);
 
 #[test]
-fn pyramid_levels_equal_sums_recomputed_from_scratch() {
+fn pyramid_levels_equal_sums_recomputed_from_scratch_after_inserts_and_removals() {
     let cell = 0.02;
     let mut grid = NdtGrid::with_levels(cell, 6).unwrap();
     let walls = common::room();
@@ -176,6 +176,15 @@ fn pyramid_levels_equal_sums_recomputed_from_scratch() {
             [w.x, w.y]
         }));
     }
+    // Remove every third fine cell, and the points in them from the naive sums.
+    let fine: Vec<CellKey> = grid.level(0).unwrap().cells().keys().copied().collect();
+    let gone: std::collections::HashSet<CellKey> = fine.iter().copied().step_by(3).collect();
+    let gone_list: Vec<CellKey> = gone.iter().copied().collect();
+    assert_eq!(grid.remove_cells(&gone_list), gone.len());
+    world.retain(|w| {
+        let k = CellKey::of(Vector2::new(w[0], w[1]), 1.0 / cell).unwrap();
+        !gone.contains(&k)
+    });
     for l in 0..6 {
         let size = cell * f64::from(1u32 << l);
         let mut naive: std::collections::HashMap<(i64, i64), Sums> = Default::default();

@@ -2,8 +2,10 @@
 //!
 //! Concurrency: the grid sits behind a read-write lock taken with the GIL
 //! released, so many threads can `match` at once while `insert` is exclusive.
+//! The lock is reference counted so that an `ndtgrid.Mapper` and the
+//! `NdtGrid` it hands out (`mapper.grid`) are one and the same map.
 
-use std::sync::RwLock;
+use std::sync::{Arc, RwLock};
 
 use ndt_core::{MatchOptions, NdtGrid, Pose2};
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
@@ -27,10 +29,15 @@ type Cells<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<i64>>);
 /// Sparse, unbounded NDT grid map (see the stub for the documentation).
 #[pyclass(name = "NdtGrid", module = "ndtgrid._core", frozen)]
 pub struct PyNdtGrid {
-    inner: RwLock<NdtGrid>,
+    inner: Arc<RwLock<NdtGrid>>,
 }
 
 impl PyNdtGrid {
+    /// A Python handle on a grid shared with its owner (the mapper).
+    pub(crate) fn shared(inner: Arc<RwLock<NdtGrid>>) -> Self {
+        Self { inner }
+    }
+
     fn read<T>(&self, py: Python<'_>, f: impl FnOnce(&NdtGrid) -> T + Send) -> PyResult<T>
     where
         T: Send,
@@ -50,7 +57,9 @@ impl PyNdtGrid {
     fn new(cell_size: f64, levels: i64) -> PyResult<Self> {
         let levels = count("levels", levels)? as usize;
         Ok(Self {
-            inner: RwLock::new(NdtGrid::with_levels(cell_size, levels).map_err(to_py)?),
+            inner: Arc::new(RwLock::new(
+                NdtGrid::with_levels(cell_size, levels).map_err(to_py)?,
+            )),
         })
     }
 

@@ -5,9 +5,12 @@
 mod convert;
 mod errors;
 mod grid;
+mod mapper;
+mod mapper_options;
 mod ranges;
 mod result;
 mod se2;
+mod small_object;
 
 use pyo3::prelude::*;
 
@@ -16,6 +19,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<grid::PyNdtGrid>()?;
     m.add_class::<result::PyMatchResult>()?;
+    m.add_class::<mapper::PyMapper>()?;
+    m.add_class::<mapper_options::PyMapperOptions>()?;
+    m.add_class::<small_object::PySmallObject>()?;
+    m.add_class::<small_object::PyRemovalCounts>()?;
+    m.add_function(wrap_pyfunction!(mapper_options::default_mapper_options, m)?)?;
     m.add_function(wrap_pyfunction!(grid::default_match_options, m)?)?;
     m.add_function(wrap_pyfunction!(ranges::ranges_to_points, m)?)?;
     m.add_function(wrap_pyfunction!(se2::compose, m)?)?;

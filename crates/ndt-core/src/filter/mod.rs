@@ -1,0 +1,55 @@
+//! §V of the paper: recognition of sub-grid objects and elimination of false
+//! detections, one step per file. The [`crate::mapper`] runs them in order on
+//! every scan:
+//!
+//! | step | file | what it does |
+//! |---|---|---|
+//! | a-1…a-4 | [`cluster`] | cluster the scan; for small clusters take the centre of mass, drop the points behind it, keep only the forefront cell |
+//! | Area 1 / 2, b-1 | [`areas`] | the 0.5 m reliable range; small-object cells never observed in Area 1 are deleted |
+//! | b-2 | [`backshift`] | a small-object point in Area 2 behind a map cell along its beam is not stored (backward shift) |
+//! | c | [`observation`] | cells observed in fewer than 2 scans are deleted, checked every third scan |
+//! | d | [`confirmation`] | cells a new beam passed through short of its hit are free space and removed |
+//!
+//! [`raywalk`] is the cell traversal along a beam that b-2 and d share, and
+//! [`objects`] groups the small-object cells into detected objects.
+
+use nalgebra::Vector2;
+
+pub mod areas;
+pub mod backshift;
+pub mod cluster;
+pub mod confirmation;
+pub mod objects;
+pub mod observation;
+pub mod raywalk;
+
+/// One valid beam of a scan, in beam order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Beam {
+    /// Index of the beam in the scan's `ranges`/`angles` arrays.
+    pub index: usize,
+    /// Measured range [m].
+    pub range: f64,
+    /// Beam angle in the sensor frame [rad].
+    pub angle: f64,
+    /// The hit in the sensor frame, `(r cos a, r sin a)` [m].
+    pub local: Vector2<f64>,
+    /// The hit in the map frame [m].
+    pub world: Vector2<f64>,
+}
+
+impl Beam {
+    /// A beam of range `range` [m] and angle `angle` [rad] seen from the
+    /// sensor pose `pose` (`T_map_scan`).
+    pub fn new(index: usize, range: f64, angle: f64, pose: crate::Pose2) -> Self {
+        let (s, c) = angle.sin_cos();
+        let local = Vector2::new(range * c, range * s);
+        Self {
+            index,
+            range,
+            angle,
+            local,
+            world: pose.transform(local),
+        }
+    }
+}
