@@ -29,7 +29,7 @@ PAPER = {
 }
 ORIGINAL = {**PAPER, "expansion": 1.0, "neighbor_search": False, "fuse_minority": False}
 SETTINGS = {
-    "2 cm, default match() (2–64 cm pyramid, 3×3 pairing, frozen degenerate directions)": (
+    "2 cm, default match() (2–64 cm pyramid, rotation multi-start, frozen degenerate directions)": (
         0.02,
         {},
     ),
