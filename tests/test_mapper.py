@@ -15,6 +15,8 @@ import pytest
 import ndtgrid
 from ndtgrid import sim
 
+from ._data import require_real
+
 STEP = np.radians(240.0 / 682.0)
 ANGLES = np.arange(-170, 171) * STEP  # 341 beams over +-60 deg, beam 170 at 0 deg
 CENTRE = 170
@@ -100,7 +102,9 @@ def test_api_names_defaults_and_repr() -> None:
         ({"no_such_option": 1}, TypeError, "no_such_option"),
     ],
 )
-def test_bad_options_are_named(kwargs: dict[str, float], exc: type[Exception], message: str) -> None:
+def test_bad_options_are_named(
+    kwargs: dict[str, float], exc: type[Exception], message: str
+) -> None:
     with pytest.raises(exc, match=message):
         ndtgrid.Mapper(**kwargs)
 
@@ -111,11 +115,11 @@ def test_grid_is_the_mappers_map_not_a_copy() -> None:
     assert m.grid is grid
     m.insert_scan(wall(1.0), ANGLES, POSE)
     assert len(grid) == len(m) > 0
-    centres, counts = grid.cells()
+    centres, _ = grid.cells()
     np.testing.assert_array_equal(centres, m.occupied_cells())
     # Matching against it sees the scan: the same scan matches back onto itself.
     pts = ndtgrid.ranges_to_points(wall(1.0), ANGLES)
-    res = grid.match(pts, POSE + [0.01, -0.005, 0.0])
+    res = grid.match(pts, POSE + np.array([0.01, -0.005, 0.0]))
     assert res.num_matched == len(pts)
     # ... and sees removals: step d empties the wall's cells when it is gone.
     before = len(grid)
@@ -166,7 +170,13 @@ def test_invalid_ranges_are_skipped() -> None:
         (np.ones((3, 2)), np.zeros(3), POSE, ValueError, r"ranges: expected a 1-D array"),
         (["a", "b"], [0.0, 0.1], POSE, TypeError, "ranges: expected real numbers"),
         (None, [0.0], POSE, TypeError, "ranges: expected"),
-        ([1.0, 1e300], [0.0, 0.1], POSE, ValueError, "ranges: point 1 at .*cell index would overflow"),
+        (
+            [1.0, 1e300],
+            [0.0, 0.1],
+            POSE,
+            ValueError,
+            "ranges: point 1 at .*cell index would overflow",
+        ),
     ],
 )
 def test_bad_input_raises_and_changes_nothing(
@@ -295,7 +305,7 @@ def test_d_removes_cells_a_newer_beam_passed_through() -> None:
     # ... but not from Area 2, where a beam may slip past a thin object.
     m = ndtgrid.Mapper(**only(radial_confirmation=True))
     m.insert_scan(near, ANGLES, POSE)
-    m.insert_scan(wall(2.5), ANGLES, POSE - [0.5, 0.0, 0.0])
+    m.insert_scan(wall(2.5), ANGLES, POSE - np.array([0.5, 0.0, 0.0]))
     assert cells_in(m, 0.40, 0.42, -0.1, 0.1) == 1
 
 
@@ -309,7 +319,9 @@ def test_a_box_moved_mid_run_disappears_from_the_map() -> None:
         )
     )
     with_box = room.with_box(-0.2, -0.15, 0.2, 0.15)
-    poses = sim.trajectory([[-1.2, -1.0], [1.2, -1.0], [1.2, 1.0], [-1.2, 1.0], [-1.2, -1.0]], step=0.05)
+    poses = sim.trajectory(
+        [[-1.2, -1.0], [1.2, -1.0], [1.2, 1.0], [-1.2, 1.0], [-1.2, -1.0]], step=0.05
+    )
     half = len(poses) // 2
     box_faces = sim.World(segments=with_box.segments[4:])
     remaining = {}
@@ -342,7 +354,10 @@ def test_a_stick_before_a_wall_beyond_half_a_metre_is_not_stored_shifted() -> No
     far = np.column_stack([np.full(60, -0.5), np.linspace(-0.05, 0.05, 60), np.zeros(60)])
     rng = np.random.default_rng(11)
     shifted = {}
-    for name, steps in (("on", {}), ("b off", {"backshift_rejection": False, "area1_confirmation": False})):
+    for name, steps in (
+        ("on", {}),
+        ("b off", {"backshift_rejection": False, "area1_confirmation": False}),
+    ):
         m = ndtgrid.Mapper(**steps)
         for pose in np.vstack([near, far]):
             ranges, angles = sim.URG04LX.scan(world, pose, rng)
@@ -386,3 +401,27 @@ def test_threads_match_while_another_inserts() -> None:
         t.join()
     assert not errors and len(matched) == 60 and min(matched) > 100
     assert m.scan_count == 40
+
+
+def test_real_urg04lx_log_stationary_start() -> None:
+    """The first 15 scans of the MinesRover log (the robot stands still): the filtered map
+    is a strict subset of the unfiltered one, and every step removes something."""
+    path = require_real("breezyslam-mines-urg04lx/exp1.dat")
+    lines = path.read_text().splitlines()[:15]
+    # Format in the log's SOURCE.md: tokens 24..705 are 682 ranges in mm, 0 = no return;
+    # 70 beams at each end see the robot's body.
+    ranges = np.array([line.split()[24:706] for line in lines], dtype=float) / 1000.0
+    ranges[:, :70] = 0.0
+    ranges[:, -70:] = 0.0
+    angles = np.radians(-120.0 + np.arange(682) * 240.0 / 681.0)
+    maps = {}
+    for name, flag in (("off", False), ("on", True)):
+        m = ndtgrid.Mapper(outlier_filter=flag, min_range=0.1, max_range=5.0)
+        for r in ranges:
+            m.insert_scan(r, angles, np.zeros(3))
+        maps[name] = m
+    off = {tuple(c) for c in np.round(maps["off"].occupied_cells(), 6)}
+    on = {tuple(c) for c in np.round(maps["on"].occupied_cells(), 6)}
+    assert on < off and len(on) < 0.9 * len(off)
+    counts = maps["on"].removal_counts().as_dict()
+    assert all(v > 0 for v in counts.values()), counts
