@@ -85,6 +85,7 @@ class Scenario:
     """One simulated run: world, true poses, odometry and scans."""
 
     seed: int
+    offset: F64
     world: sim.World
     poses: F64
     odom: F64
@@ -108,6 +109,7 @@ class Result:
     pose_max: float  # cm
     ms_per_scan: float
     counts: dict[str, int] = field(default_factory=dict)
+    kinds: tuple[int, int, int] = (0, 0, 0)  # false cells near sticks / behind walls / free space
 
 
 def scenario(seed: int, laser: sim.Laser = sim.URG04LX) -> Scenario:
@@ -117,7 +119,7 @@ def scenario(seed: int, laser: sim.Laser = sim.URG04LX) -> Scenario:
     poses = sim.trajectory(world.tour)
     odom = sim.odometry(poses, drift=0.02, seed=seed)
     ranges, angles = sim.simulate(world, laser, poses, seed=seed)
-    return Scenario(seed, world, poses, odom, ranges, angles)
+    return Scenario(seed, offset, world, poses, odom, ranges, angles)
 
 
 def build(
@@ -174,6 +176,22 @@ def measure(mapper: ndtgrid.Mapper, world: sim.World) -> tuple[int, int, F64, F6
     return len(cells), false_cells, map_err, obj_err, len(centres) - len(used)
 
 
+def false_kinds(cells: F64, scn: Scenario) -> tuple[int, int, int]:
+    """False cells within 15 cm of a stick, outside the room (behind its walls or inside the
+    cabinet), and elsewhere in free space. Knows the sticks room's layout."""
+    w = scn.world
+    false = w.distance_to_surface(cells) > FALSE_DISTANCE
+    x, y = (cells - scn.offset).T
+    inside = (np.abs(x) < 2.5) & (np.abs(y) < 2.0) & ~((np.abs(x) < 0.4) & (y > 1.75))
+    d = np.hypot(cells[:, None, 0] - w.sticks[None, :, 0], cells[:, None, 1] - w.sticks[None, :, 1])
+    near = d.min(axis=1) < 0.15
+    return (
+        int((false & near).sum()),
+        int((false & ~inside).sum()),
+        int((false & inside & ~near).sum()),
+    )
+
+
 def run_sim(seeds: int, plots: Path | None) -> list[Result]:
     """Every variant x pose source x seed."""
     try:
@@ -207,6 +225,7 @@ def run_sim(seeds: int, plots: Path | None) -> list[Result]:
                         float(perr.max()),
                         ms,
                         mapper.removal_counts().as_dict(),
+                        false_kinds(mapper.occupied_cells(), scn),
                     )
                 )
                 if plots is not None and seed == 0 and own and name in ("off", "all on"):
@@ -308,6 +327,17 @@ def report_sim(results: list[Result], seeds: int) -> str:
         lines.append(f"| {name} | " + " | ".join(cols) + f" | {tail} |")
     lines += [
         "",
+        "False cells by kind, own poses, mean over seeds (near: within 15 cm of a stick; "
+        "outside: behind the walls or in the cabinet; free space: the rest of the room):",
+        "",
+        "| variant | near sticks | outside | free space |",
+        "|---|---|---|---|",
+    ]
+    for name in VARIANTS:
+        k = np.mean([r.kinds for r in results if r.variant == name and r.own], axis=0)
+        lines.append(f"| {name} | {k[0]:.1f} | {k[1]:.1f} | {k[2]:.1f} |")
+    lines += [
+        "",
         "Cells / points each step removed, all steps on, own poses, mean over seeds:",
         "",
         "| " + " | ".join(COUNT_KEYS) + " |",
@@ -395,8 +425,8 @@ def plot_fig8(out: Path, scn: Scenario) -> None:
             ax.set_xlabel("x [m]")
             ax.set_ylabel("y [m]")
         fig.suptitle(
-            "Simulated sticks room, URG-04LX model, own poses, 2 cm cells "
-            "(black: occupied cells, red: true sticks, +: detected small objects)",
+            "Simulated sticks room, URG-04LX model, own poses, 2 cm cells\n"
+            "black: occupied cells, red: true sticks, +: detected small objects",
             fontsize=9,
         )
         fig.savefig(out / fname, dpi=110)

@@ -199,6 +199,19 @@ def test_bad_input_raises_and_changes_nothing(
 STICK_NEAR = [0.445, 0.411, 0.410, 0.411, 0.455]
 
 
+def test_a1_only_clusters_narrower_than_small_object_size_are_small_objects() -> None:
+    """a-1: a cluster is a small object when its extent across the beam is at most
+    small_object_size (5 cm); wider clusters are stored whole, as big objects."""
+    for width_beams, small in ((7, True), (40, False)):  # 1.5 cm and 10 cm at 0.41 m
+        first = CENTRE - width_beams // 2
+        scan = stick(np.zeros_like(ANGLES), [0.41] * width_beams, first)
+        m = ndtgrid.Mapper(**only(edge_removal=True))
+        m.insert_scan(scan, ANGLES, POSE)
+        assert len(m.small_objects()) == (1 if small else 0)
+        stored = int(m.grid.cells()[1].sum())
+        assert (stored < width_beams) if small else (stored == width_beams)
+
+
 def test_a3_drops_points_behind_the_centre_of_mass() -> None:
     """a-2/a-3: in a small cluster the points behind its centre of mass are not stored."""
     scan = stick(np.zeros_like(ANGLES), STICK_NEAR)
