@@ -33,126 +33,30 @@ import os
 import platform
 import subprocess
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
+from subgrid_common import (
+    COUNT_KEYS,
+    F64,
+    FALSE_DISTANCE,
+    MAP_RADIUS,
+    OBJECT_RADIUS,
+    REAL_LOG,
+    STICK_NAMES,
+    VARIANTS,
+    Result,
+    Scenario,
+    build,
+    scenario,
+)
+from subgrid_plots import plot_fig8
+from subgrid_real import run_real
 
 import ndtgrid
-from ndtgrid import se2, sim
-
-F64 = npt.NDArray[np.float64]
-
-CELL = 0.02
-#: A cell farther than this from every surface is a false cell [m] (the issue's definition).
-FALSE_DISTANCE = 0.03
-#: Occupied cells within this of a stick make its map CoM [m].
-MAP_RADIUS = 0.10
-#: A small object within this of a stick detects it [m].
-OBJECT_RADIUS = 0.05
-
-STEPS_OFF = {
-    "edge_removal": False,
-    "area1_confirmation": False,
-    "backshift_rejection": False,
-    "observation_check": False,
-    "radial_confirmation": False,
-}
-VARIANTS: dict[str, dict[str, bool]] = {
-    "off": {"outlier_filter": False},
-    "a only": {**STEPS_OFF, "edge_removal": True},
-    "b only": {**STEPS_OFF, "area1_confirmation": True, "backshift_rejection": True},
-    "c only": {**STEPS_OFF, "observation_check": True},
-    "d only": {**STEPS_OFF, "radial_confirmation": True},
-    "all on": {},
-}
-
-REAL_LOG = (
-    Path(__file__).resolve().parents[1].parent
-    / "shared/data/real/breezyslam-mines-urg04lx/exp1.dat"
-)
-
-
-# --------------------------------------------------------------------------------------
-# Part 1: simulation
-# --------------------------------------------------------------------------------------
-
-
-@dataclass
-class Scenario:
-    """One simulated run: world, true poses, odometry and scans."""
-
-    seed: int
-    offset: F64
-    world: sim.World
-    poses: F64
-    odom: F64
-    ranges: F64
-    angles: F64
-
-
-@dataclass
-class Result:
-    """Measures of one final map."""
-
-    variant: str
-    seed: int
-    own: bool
-    cells: int
-    false_cells: int
-    map_err: F64  # (8,) cm, NaN = not found
-    obj_err: F64  # (8,) cm, NaN = not found
-    spurious_objects: int
-    pose_rmse: float  # cm
-    pose_max: float  # cm
-    ms_per_scan: float
-    counts: dict[str, int] = field(default_factory=dict)
-    kinds: tuple[int, int, int] = (0, 0, 0)  # false cells near sticks / behind walls / free space
-
-
-def scenario(seed: int, laser: sim.Laser = sim.URG04LX) -> Scenario:
-    """The sticks room shifted by a random sub-cell offset, the tour, odometry, scans."""
-    offset = np.random.default_rng(1000 + seed).uniform(0.0, CELL, 2)
-    world = sim.sticks_room().translated(*offset)
-    poses = sim.trajectory(world.tour)
-    odom = sim.odometry(poses, drift=0.02, seed=seed)
-    ranges, angles = sim.simulate(world, laser, poses, seed=seed)
-    return Scenario(seed, offset, world, poses, odom, ranges, angles)
-
-
-def build(
-    ranges: F64,
-    angles: F64,
-    odom: F64,
-    options: dict[str, Any],
-    *,
-    truth: F64 | None = None,
-    max_range: float = np.inf,
-    min_range: float = 0.0,
-) -> tuple[ndtgrid.Mapper, F64, float]:
-    """Build a map scan by scan; with ``truth`` at those poses, else with our own matching.
-
-    Returns the mapper, the (T, 3) poses used and the mean time per scan [ms].
-    """
-    mapper = ndtgrid.Mapper(CELL, min_range=min_range, max_range=max_range, **options)
-    used = np.empty_like(odom)
-    est = odom[0] if truth is None else truth[0]
-    t0 = time.perf_counter()
-    for k in range(len(ranges)):
-        if truth is not None:
-            est = truth[k]
-        elif k > 0:
-            guess = se2.compose(est, se2.between(odom[k - 1], odom[k]))
-            pts = ndtgrid.ranges_to_points(
-                ranges[k], angles, min_range=max(min_range, 1e-9), max_range=max_range
-            )
-            est = mapper.grid.match(pts, guess).pose if len(pts) >= 10 else guess
-        mapper.insert_scan(ranges[k], angles, est)
-        used[k] = est
-    ms = 1e3 * (time.perf_counter() - t0) / max(1, len(ranges))
-    return mapper, used, ms
+from ndtgrid import sim
 
 
 def measure(mapper: ndtgrid.Mapper, world: sim.World) -> tuple[int, int, F64, F64, int]:
@@ -231,7 +135,7 @@ def run_sim(seeds: int, plots: Path | None) -> list[Result]:
                 if plots is not None and seed == 0 and own and name in ("off", "all on"):
                     plot_store[name] = (mapper, used, scn)
         if plots is not None and seed == 0:
-            plot_fig8(plots, scn)
+            plot_fig8(plots, scn, plot_store)
     return results
 
 
@@ -352,183 +256,7 @@ def report_sim(results: list[Result], seeds: int) -> str:
     return "\n".join(lines)
 
 
-STICK_NAMES = ["W1", "W2", "W3", "W4", "W5", "W6", "I1", "I2"]
-COUNT_KEYS = [
-    "behind_com_points",
-    "behind_com_cells",
-    "forefront_points",
-    "forefront_cells",
-    "area1_cells",
-    "backshift_points",
-    "backshift_cells",
-    "observation_cells",
-    "confirmation_cells",
-]
 scenario_len_cache: list[int] = []
-
-
-# --------------------------------------------------------------------------------------
-# Pictures
-# --------------------------------------------------------------------------------------
-
-
-def _plt() -> Any:
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as err:  # pragma: no cover - optional dependency
-        raise ImportError("the pictures need matplotlib: pip install ndtgrid[plot]") from err
-    return plt
-
-
-def _draw_cells(ax: Any, cells: F64, color: str = "black") -> None:
-    from matplotlib.collections import PatchCollection
-    from matplotlib.patches import Rectangle
-
-    rects = [Rectangle((x - CELL / 2, y - CELL / 2), CELL, CELL) for x, y in cells]
-    ax.add_collection(PatchCollection(rects, facecolor=color, edgecolor="none"))
-
-
-def plot_fig8(out: Path, scn: Scenario) -> None:
-    """Fig. 8/9-style pictures of seed 0 (own poses): off vs all on, whole map and a zoom."""
-    plt = _plt()
-    world = scn.world
-    panels = [("off", "(a) without elimination"), ("all on", "(b) with the §V elimination")]
-    for zoom, fname, size in (
-        (None, "fig8_sticks_room.png", (11, 4.6)),
-        (3, "fig9_iron_stick.png", (8, 4)),
-    ):
-        fig, axes = plt.subplots(1, 2, figsize=size, constrained_layout=True)
-        for ax, (name, title) in zip(axes, panels):
-            mapper, used, _ = plot_store[name]
-            cells = mapper.occupied_cells()
-            _draw_cells(ax, cells)
-            ax.plot(used[:, 0], used[:, 1], color="0.6", lw=0.8)
-            for x, y, d in world.sticks:
-                ax.add_patch(plt.Circle((x, y), d / 2, fill=False, color="red", lw=1.0))
-            for o in mapper.small_objects():
-                ax.plot(*o.center, "+", color="tab:blue", ms=8 if zoom else 5, mew=1.2)
-            if zoom is None:
-                ax.set_xlim(-2.7, 2.7)
-                ax.set_ylim(-2.2, 2.2)
-                false_cells = int((world.distance_to_surface(cells) > FALSE_DISTANCE).sum())
-                ax.set_title(f"{title}\n{len(cells)} cells, {false_cells} false (> 3 cm)")
-            else:
-                x, y, _ = world.sticks[6]
-                ax.set_xlim(x - 0.2, x + 0.2)
-                ax.set_ylim(y - 0.2, y + 0.2)
-                ax.set_title(f"{title}\niron stick at the centre", fontsize=10)
-                ax.grid(True, color="0.9", lw=0.5)
-            ax.set_aspect("equal")
-            ax.set_xlabel("x [m]")
-            ax.set_ylabel("y [m]")
-        fig.suptitle(
-            "Simulated sticks room, URG-04LX model, own poses, 2 cm cells\n"
-            "black: occupied cells, red: true sticks, +: detected small objects",
-            fontsize=9,
-        )
-        fig.savefig(out / fname, dpi=110)
-        plt.close(fig)
-
-
-def plot_real(out: Path, maps: dict[str, tuple[ndtgrid.Mapper, F64]]) -> None:
-    """The real log's maps: off and on at the same poses, and on with its own matching."""
-    plt = _plt()
-    names = ("off", "all on", "all on, own matching")
-    fig, axes = plt.subplots(1, 3, figsize=(16, 6), constrained_layout=True)
-    for ax, name in zip(axes, names):
-        mapper, used = maps[name]
-        cells = mapper.occupied_cells()
-        _draw_cells(ax, cells)
-        ax.plot(used[:, 0], used[:, 1], color="tab:orange", lw=0.8)
-        ax.set_title(f"exp1.dat, elimination {name}: {len(cells)} cells", fontsize=10)
-        ax.set_aspect("equal")
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
-    fig.savefig(out / "real_exp1_off_on.png", dpi=100)
-    plt.close(fig)
-
-
-# --------------------------------------------------------------------------------------
-# Part 2: the real URG-04LX log
-# --------------------------------------------------------------------------------------
-
-
-def _load_mines_private(path: Path) -> tuple[F64, F64, F64]:
-    """PRIVATE minimal reader of the BreezySLAM/MinesRover ``exp*.dat`` format (see its
-    SOURCE.md). Bench-only: the proper reader belongs in ``ndtgrid.io``.
-
-    Returns ranges (T, 682) [m] (0 = no return), angles (682,) [rad] and the odometry
-    poses (T, 3) of the *laser* (robot pose o 145 mm forward offset).
-    """
-    rows = np.array([line.split() for line in path.read_text().splitlines()], dtype=np.float64)
-    ranges = rows[:, 24:706] / 1000.0  # the shipped loader's tokens 24..705, mm -> m
-    # The robot body blocks 70 beams at each end (mines.py's detection margin).
-    ranges[:, :70] = 0.0
-    ranges[:, -70:] = 0.0
-    angles = np.radians(-120.0 + np.arange(682) * 240.0 / 681.0)
-    # Wheel odometry as BreezySLAM's vehicles.py: degrees = ticks * 180 / 2000.
-    r, half_axle = 77.0, 165.0
-    deg = rows[:, 2:4] * 180.0 / 2000.0
-    d = np.diff(deg, axis=0)
-    dxy = r * (np.radians(d[:, 0]) + np.radians(d[:, 1])) / 1000.0
-    dth = np.radians((r / half_axle) * (d[:, 1] - d[:, 0]))
-    robot = np.zeros((len(rows), 3))
-    for k in range(1, len(rows)):
-        robot[k] = se2.compose(robot[k - 1], [dxy[k - 1], 0.0, dth[k - 1]])
-    laser = np.array([se2.compose(p, [0.145, 0.0, 0.0]) for p in robot])
-    return ranges, angles, laser
-
-
-def run_real(path: Path, out: Path | None) -> str:
-    """The real log: every variant at the same poses, and all on with its own matching.
-
-    The poses come from our matching with the elimination off (wheel odometry as the
-    guess), so the maps differ by the elimination alone. A last run matches against the
-    filtered map itself, as a SLAM loop would.
-    """
-    ranges, angles, odom = _load_mines_private(path)
-    _, ref_used, _ = build(ranges, angles, odom, VARIANTS["off"], min_range=0.1, max_range=5.0)
-    lines = [
-        f"Real log `{path.name}`: {len(ranges)} scans, URG-04LX, ranges 0.1-5.0 m, beams 70-611. "
-        "Every variant at the same poses (our matching against the unfiltered map, wheel "
-        "odometry as the guess); the counters are cumulative over the run (a cell deleted, "
-        "re-observed and deleted again counts twice).",
-        "",
-        "| variant | cells | ms/scan | " + " | ".join(COUNT_KEYS) + " |",
-        "|---|---|---|" + "---|" * len(COUNT_KEYS),
-    ]
-    maps: dict[str, tuple[ndtgrid.Mapper, F64]] = {}
-    for name, opts in VARIANTS.items():
-        mapper, used, ms = build(
-            ranges, angles, odom, opts, truth=ref_used, min_range=0.1, max_range=5.0
-        )
-        maps[name] = (mapper, used)
-        counts = mapper.removal_counts().as_dict()
-        lines.append(
-            f"| {name} | {len(mapper)} | {ms:.2f} | "
-            + " | ".join(str(counts[k]) for k in COUNT_KEYS)
-            + " |"
-        )
-    loop, loop_used, ms = build(
-        ranges, angles, odom, VARIANTS["all on"], min_range=0.1, max_range=5.0
-    )
-    maps["all on, own matching"] = (loop, loop_used)
-    dev = 100 * np.hypot(*(loop_used[:, :2] - ref_used[:, :2]).T)
-    lines += [
-        "",
-        f"All on, matching against the filtered map itself: {len(loop)} cells, {ms:.2f} ms/scan; "
-        f"its trajectory departs from the reference by {np.sqrt(np.mean(dev**2)):.1f} cm RMS, "
-        f"{dev.max():.1f} cm at most (no ground truth: neither is known to be right).",
-    ]
-    if out is not None:
-        plot_real(out, maps)
-    return "\n".join(lines)
-
-
-# --------------------------------------------------------------------------------------
 
 
 def machine() -> str:
