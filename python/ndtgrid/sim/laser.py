@@ -15,8 +15,9 @@ The model, beam by beam (all numbers are :class:`Laser` fields):
 3. **Small object in front of a wall** (§V-A, Fig. 7b). When the near surface
    is a sub-grid object (a stick), lies beyond ``reliable_range`` and a wall
    or big object stands at most ``backshift_reach`` behind it along the beam,
-   the whole return is shifted backward by ``backshift``, never past that
-   wall. Within ``reliable_range`` sticks are measured correctly.
+   every return from it reads ``backshift`` behind its surface (instead of
+   the mixing of 2.), never past that wall. Within ``reliable_range`` sticks
+   are measured correctly.
 4. **Wall speckle** (§V-A, "surface of wall"). A fully covered beam on a big
    surface returns, with probability ``speckle_probability``, a range off by
    a uniform ``speckle_offset`` (either sign).
@@ -252,7 +253,7 @@ class Laser:
             with np.errstate(invalid="ignore"):
                 gap = np.where(on_stick, behind - r_cov, np.inf)
             shifted = on_stick & (r_cov > self.reliable_range) & (gap <= self.backshift_reach)
-            ranges[shifted] = np.minimum(ranges[shifted] + self.backshift, behind[shifted])
+            ranges[shifted] = np.minimum(r_cov[shifted] + self.backshift, behind[shifted])
 
         sigma = np.maximum(self.range_sigma, self.range_sigma_relative * np.nan_to_num(ranges))
         ranges = ranges + sigma * noise
