@@ -6,8 +6,11 @@ reference pose: a wide set (uniform in ±0.4 m, ±10°) and a local set (±5 cm,
 ±2°). Success: final error < 5 cm and < 1° on real pairs (their reference is a
 SLAM result good to a few cm), < 2 cm and < 0.5° on simulated pairs.
 
-Run: ``python benches/convergence.py [--pairs 12] [--starts 10]``; prints a
-Markdown table per start set.
+Simulated pairs come from ``ndtgrid.sim`` (the sticks room, URG-04LX and
+SICK-like presets, with the simulator's noise and false detections).
+
+Run: ``python benches/convergence.py [--pairs 12] [--starts 8] [--sim-pairs 8]``;
+prints a Markdown table per pair set and start set.
 """
 
 from __future__ import annotations
@@ -55,6 +58,26 @@ class Pair:
     target: np.ndarray
     source: np.ndarray
     truth: np.ndarray
+    tol: tuple[float, float] = (0.05, np.radians(1.0))  # success: error below [m, rad]
+
+
+def sim_pairs(count: int, seed: int = 0) -> Iterator[Pair]:
+    """``count`` pairs per laser preset from ``ndtgrid.sim``: the sticks room,
+    scans 0.3 m apart along its tour, the simulator's noise and false detections.
+    Success: < 2 cm and < 0.5° (the truth is exact)."""
+    from ndtgrid import sim
+
+    room = sim.sticks_room()
+    poses = sim.trajectory(room.tour, step=0.05)
+    rng = np.random.default_rng(seed)
+    for laser in (sim.URG04LX, sim.SICK_LMS):
+        for i in np.linspace(0, len(poses) - 7, count).astype(int):
+            a, b = poses[i], poses[i + 6]
+            ra, aa = laser.scan(room, a, rng=rng)
+            rb, ab = laser.scan(room, b, rng=rng)
+            pa = ndtgrid.ranges_to_points(ra, aa, max_range=laser.max_range)
+            pb = ndtgrid.ranges_to_points(rb, ab, max_range=laser.max_range)
+            yield Pair(f"sim {laser.name}", apply(a, pa), pb, b, (0.02, np.radians(0.5)))
 
 
 def real_pairs(per_log: int) -> Iterator[Pair]:
@@ -141,7 +164,7 @@ def run(
                 times.append(time.perf_counter() - t0)
                 et, er = pose_error(pose, pair.truth)
                 errs.append((et, er))
-                ok += et < 0.05 and er < np.radians(1.0)
+                ok += et < pair.tol[0] and er < pair.tol[1]
         e = np.array(errs)
         print(
             f"| {m.name} | {100 * ok / len(e):.0f} % | {100 * np.median(e[:, 0]):.1f} / "
@@ -156,15 +179,23 @@ def main() -> None:
     ap.add_argument("--pairs", type=int, default=12, help="pairs per real log")
     ap.add_argument("--starts", type=int, default=10, help="starts per pair and set")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--sim-pairs", type=int, default=8, help="pairs per simulated laser")
     args = ap.parse_args()
-    pairs = list(real_pairs(args.pairs))
     ms = methods()
-    print(f"{len(pairs)} real pairs ({', '.join(LOGS)}), {args.starts} starts each")
-    rng = np.random.default_rng(args.seed)
-    wide = [starts(rng, args.starts, 0.4, 10.0) for _ in pairs]
-    local = [starts(rng, args.starts, 0.05, 2.0) for _ in pairs]
-    run(pairs, ms, lambda i: local[i], "Real pairs, local starts (±5 cm, ±2°)")
-    run(pairs, ms, lambda i: wide[i], "Real pairs, wide starts (±0.4 m, ±10°)")
+    sets = [
+        ("Real pairs", list(real_pairs(args.pairs))),
+        ("Simulated pairs", list(sim_pairs(args.sim_pairs, args.seed))),
+    ]
+    for title, pairs in sets:
+        if not pairs:
+            continue
+        groups = sorted({p.group for p in pairs})
+        print(f"\n{title}: {len(pairs)} pairs ({', '.join(groups)}), {args.starts} starts each")
+        rng = np.random.default_rng(args.seed)
+        wide = [starts(rng, args.starts, 0.4, 10.0) for _ in pairs]
+        local = [starts(rng, args.starts, 0.05, 2.0) for _ in pairs]
+        run(pairs, ms, lambda i, s=local: s[i], f"{title}, local starts (±5 cm, ±2°)")
+        run(pairs, ms, lambda i, s=wide: s[i], f"{title}, wide starts (±0.4 m, ±10°)")
 
 
 if __name__ == "__main__":
