@@ -2,7 +2,8 @@
 //! and 20 cm grids (one core, one thread).
 //!
 //! The map is the synthetic room of the tests, built from eight scans; the
-//! matched scan is taken 3 cm / 1° away from its guess.
+//! matched scan is taken 3 cm / 1° away from its guess. `match` uses the
+//! default options (pyramid), `match_paper` the paper's method alone.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -58,22 +59,38 @@ fn bench_insert(c: &mut Criterion) {
     group.finish();
 }
 
+/// The paper's method alone (§IV-A on the fine grid only).
+fn paper() -> MatchOptions {
+    MatchOptions {
+        levels: Some(1),
+        rotation_search: 0.0,
+        freeze_unconstrained: false,
+        search_radius: 3,
+        ..MatchOptions::default()
+    }
+}
+
 fn bench_match(c: &mut Criterion) {
-    let mut group = c.benchmark_group("match");
+    for (name, options) in [("match", MatchOptions::default()), ("match_paper", paper())] {
+        bench_match_with(c, name, &options);
+    }
+}
+
+fn bench_match_with(c: &mut Criterion, name: &str, options: &MatchOptions) {
+    let mut group = c.benchmark_group(name);
     for cell in CELLS {
         for beams in BEAMS {
             let grid = map(beams, cell);
             let truth = Pose2::new(0.1, -0.05, 0.3);
             let pts = scan(beams, truth, 42);
             let guess = Pose2::new(truth.x + 0.03, truth.y - 0.02, truth.theta + 0.017);
-            let options = MatchOptions::default();
             // Build the distributions once, as a SLAM loop's map already has them.
-            let _ = grid.match_scan(&pts, guess, &options);
+            let _ = grid.match_scan(&pts, guess, options);
             group.throughput(Throughput::Elements(pts.len() as u64));
             group.bench_with_input(
                 BenchmarkId::new(format!("cell_{}cm", cell * 100.0), beams),
                 &pts,
-                |b, pts| b.iter(|| grid.match_scan(black_box(pts), guess, &options)),
+                |b, pts| b.iter(|| grid.match_scan(black_box(pts), guess, options)),
             );
         }
     }
