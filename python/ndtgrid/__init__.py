@@ -18,5 +18,16 @@ from __future__ import annotations
 
 from ndtgrid import io, se2
 from ndtgrid._core import MatchResult, NdtGrid, __version__, default_match_options
+from ndtgrid.odometry import Odometry, OdometryConfig, OdometryStep
 
-__all__ = ["MatchResult", "NdtGrid", "__version__", "default_match_options", "io", "se2"]
+__all__ = [
+    "MatchResult",
+    "NdtGrid",
+    "Odometry",
+    "OdometryConfig",
+    "OdometryStep",
+    "__version__",
+    "default_match_options",
+    "io",
+    "se2",
+]

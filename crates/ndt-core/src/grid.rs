@@ -12,6 +12,8 @@ use crate::error::{check_finite, NdtError, Result};
 use crate::key::{CellKey, MAX_INDEX};
 use crate::se2::Pose2;
 
+mod edit;
+
 /// How many prepared distribution sets (one per distinct expansion/fusion
 /// setting) a grid keeps between calls.
 const PREPARED_CAPACITY: usize = 4;

@@ -17,10 +17,12 @@
 pub mod cell;
 pub mod distributions;
 pub mod error;
+pub mod freespace;
 pub mod grid;
 pub mod key;
 pub mod matcher;
 pub mod neighbor;
+pub mod odometry;
 pub mod ranges;
 pub mod score;
 pub mod se2;
@@ -28,10 +30,12 @@ pub mod solver;
 
 pub use cell::{CellStats, Gaussian};
 pub use error::{NdtError, Result};
+pub use freespace::{FreeSpace, Raster};
 pub use grid::{CellRecord, NdtGrid};
 pub use key::CellKey;
 pub use matcher::{MatchOptions, MatchResult};
 pub use nalgebra;
+pub use odometry::{Odometry, OdometryConfig, StepOutcome};
 pub use ranges::points_from_ranges;
 pub use score::{Order, ScoreTerms};
 pub use se2::{wrap_angle, Pose2};

@@ -4,10 +4,13 @@
 
 mod convert;
 mod errors;
+mod freespace;
 mod grid;
+mod odometry;
 mod ranges;
 mod result;
 mod se2;
+mod state;
 
 use pyo3::prelude::*;
 
@@ -16,6 +19,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<grid::PyNdtGrid>()?;
     m.add_class::<result::PyMatchResult>()?;
+    m.add_class::<odometry::PyOdometry>()?;
+    m.add_class::<odometry::PyStep>()?;
+    m.add_class::<freespace::PyFreeSpace>()?;
+    m.add_function(wrap_pyfunction!(odometry::default_odometry_config, m)?)?;
     m.add_function(wrap_pyfunction!(grid::default_match_options, m)?)?;
     m.add_function(wrap_pyfunction!(ranges::ranges_to_points, m)?)?;
     m.add_function(wrap_pyfunction!(se2::compose, m)?)?;
