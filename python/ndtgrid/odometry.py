@@ -67,11 +67,11 @@ class OdometryConfig:
     insert_angle: float = math.radians(5.0)
     map_window: int = 200
     min_match_ratio: float = 0.3
-    rotation_search: float = 0.0
-    rotation_step: float = math.radians(0.5)
-    prior_gap_distance: float = 0.25
-    prior_gap_angle: float = math.radians(15.0)
-    expansion: float = 10.0
+    rotation_search: float = math.radians(10.0)
+    rotation_step: float = math.radians(1.0)
+    prior_gap_distance: float = 0.1
+    prior_gap_angle: float = math.radians(5.0)
+    expansion: float = 30.0
     neighbor_search: bool = True
     fuse_minority: bool = True
     search_radius: int = 3

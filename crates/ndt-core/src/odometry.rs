@@ -64,6 +64,7 @@ pub struct OdometryConfig {
     pub prior_gap_distance: f64,
     /// The rotation of that gap [rad].
     pub prior_gap_angle: f64,
+
     /// The matcher's options (§IV-A).
     pub matcher: MatchOptions,
 }
@@ -78,11 +79,15 @@ impl Default for OdometryConfig {
             insert_angle: 5f64.to_radians(),
             map_window: 200,
             min_match_ratio: 0.3,
-            rotation_search: 0.0,
-            rotation_step: 0.5f64.to_radians(),
-            prior_gap_distance: 0.25,
-            prior_gap_angle: 15f64.to_radians(),
-            matcher: MatchOptions::default(),
+            rotation_search: 10f64.to_radians(),
+            rotation_step: 1f64.to_radians(),
+            prior_gap_distance: 0.1,
+            prior_gap_angle: 5f64.to_radians(),
+
+            matcher: MatchOptions {
+                expansion: 30.0,
+                ..MatchOptions::default()
+            },
         }
     }
 }

@@ -116,6 +116,7 @@ impl PyOdometry {
         rotation_step: Option<f64>,
         prior_gap_distance: Option<f64>,
         prior_gap_angle: Option<f64>,
+
         expansion: Option<f64>,
         neighbor_search: Option<bool>,
         fuse_minority: Option<bool>,
@@ -158,6 +159,7 @@ impl PyOdometry {
             rotation_step: rotation_step.unwrap_or(d.rotation_step),
             prior_gap_distance: prior_gap_distance.unwrap_or(d.prior_gap_distance),
             prior_gap_angle: prior_gap_angle.unwrap_or(d.prior_gap_angle),
+
             matcher,
         };
         Ok(Self {
@@ -237,6 +239,7 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("rotation_step", c.rotation_step)?;
     out.set_item("prior_gap_distance", c.prior_gap_distance)?;
     out.set_item("prior_gap_angle", c.prior_gap_angle)?;
+
     out.set_item("expansion", c.matcher.expansion)?;
     out.set_item("neighbor_search", c.matcher.neighbor_search)?;
     out.set_item("fuse_minority", c.matcher.fuse_minority)?;
