@@ -20,7 +20,9 @@ def line(stamp: int, left: int, right: int, ranges_mm: list[int]) -> str:
     """A 707-token line: stamp, 1 undocumented, ticks, 20 status fields, 0, 682 ranges."""
     assert len(ranges_mm) == 682
     status = ["0"] * 20
-    return " ".join([str(stamp), "14710", str(left), str(right), *status, "0 ", *map(str, ranges_mm)])
+    return " ".join(
+        [str(stamp), "14710", str(left), str(right), *status, "0 ", *map(str, ranges_mm)]
+    )
 
 
 def write(path: Path, lines: list[str]) -> Path:

@@ -50,7 +50,7 @@ def test_errors_are_the_component_wise_difference_of_the_relations() -> None:
 
 def test_pairs_select_relations_and_are_checked() -> None:
     ref = chain([0, 0, 0], INCREMENTS)
-    est = ref + [0.0, 0.0, 0.0]
+    est = ref.copy()
     est[4] = se2.compose(est[4], [0.1, 0.0, 0.0])
     e = relation_errors(est, ref, pairs=[[0, 4], [0, 2]])
     np.testing.assert_allclose(e.translation, [0.1, 0.0], atol=1e-12)

@@ -98,7 +98,7 @@ def _progress(items: Iterable[T], quiet: bool) -> Iterator[T]:
         yield from items
         return
     try:
-        from tqdm import tqdm
+        from tqdm import tqdm  # type: ignore[import-untyped,unused-ignore]
     except ImportError:
         start = time.perf_counter()
         n = 0
@@ -178,9 +178,7 @@ def run_eval(args: argparse.Namespace) -> int:
         column = args.reference_time
         if column == "auto":
             column = "raw_scan" if np.all(times == np.round(times)) else "ipc_ts"
-        ref_times = (
-            index.raw_scan.astype(np.float64) if column == "raw_scan" else index.timestamp
-        )
+        ref_times = index.raw_scan.astype(np.float64) if column == "raw_scan" else index.timestamp
         ref_poses = index.corrected
     else:
         ref_times, ref_poses = read_tum(args.reference)

@@ -163,8 +163,10 @@ class Odometry:
             On a wrong shape or type, lengths that differ, or a non-finite angle or odom;
             the loop is unchanged after an error.
         """
-        self._last = self._loop.step(ranges, angles, odom)
-        return self._last.pose
+        step = self._loop.step(ranges, angles, odom)
+        self._last = step
+        pose: F64 = step.pose
+        return pose
 
     @property
     def last_step(self) -> OdometryStep | None:
@@ -174,12 +176,13 @@ class Odometry:
     @property
     def poses(self) -> F64:
         """Pose of every scan so far, shape (T, 3)."""
-        return self._loop.poses
+        poses: F64 = self._loop.poses
+        return poses
 
     @property
     def insertions(self) -> int:
         """Scans added to the map so far."""
-        return self._loop.insertions
+        return int(self._loop.insertions)
 
     def __len__(self) -> int:
         """Cells in the map now."""
@@ -187,7 +190,8 @@ class Odometry:
 
     def grid(self) -> NdtGrid:
         """A copy of the map the scans are matched against."""
-        return self._loop.grid()
+        grid: NdtGrid = self._loop.grid()
+        return grid
 
     def __repr__(self) -> str:
         return (

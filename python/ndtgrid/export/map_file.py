@@ -73,7 +73,7 @@ def load_map(path: str | os.PathLike[str]) -> NdtGrid:
                 f"{fmt!r} version {version!r}"
             )
         try:
-            return NdtGrid.from_cell_states(
+            grid: NdtGrid = NdtGrid.from_cell_states(
                 float(data["cell_size"]),
                 data["indices"],
                 data["counts"],
@@ -82,3 +82,4 @@ def load_map(path: str | os.PathLike[str]) -> NdtGrid:
             )
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
+    return grid

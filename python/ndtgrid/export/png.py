@@ -20,9 +20,7 @@ def _pyplot() -> Any:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError as exc:  # pragma: no cover - depends on the environment
-        raise ImportError(
-            "writing PNG images needs matplotlib: pip install ndtgrid[plot]"
-        ) from exc
+        raise ImportError("writing PNG images needs matplotlib: pip install ndtgrid[plot]") from exc
     return plt
 
 
@@ -61,8 +59,15 @@ def write_png(
     extent = (x0, x0 + w * image.resolution, y0, y0 + h * image.resolution)
     fig, ax = plt.subplots(figsize=(8, 8 * h / max(w, 1) + 0.5))
     try:
-        ax.imshow(grey, cmap="gray", vmin=0.0, vmax=1.0, origin="lower", extent=extent,
-                  interpolation="nearest")
+        ax.imshow(
+            grey,
+            cmap="gray",
+            vmin=0.0,
+            vmax=1.0,
+            origin="lower",
+            extent=extent,
+            interpolation="nearest",
+        )
         if trajectory is not None:
             t = np.asarray(trajectory, dtype=np.float64)
             ax.plot(t[:, 0], t[:, 1], "-", color="tab:red", linewidth=0.6, label="trajectory")

@@ -20,7 +20,9 @@ __all__ = ["read_tum", "write_tum"]
 F64 = npt.NDArray[np.float64]
 
 
-def write_tum(path: str | os.PathLike[str], timestamps: npt.ArrayLike, poses: npt.ArrayLike) -> None:
+def write_tum(
+    path: str | os.PathLike[str], timestamps: npt.ArrayLike, poses: npt.ArrayLike
+) -> None:
     """Write a planar trajectory as a TUM file.
 
     Parameters

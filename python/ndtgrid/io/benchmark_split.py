@@ -157,8 +157,7 @@ def _parse_member(data: bytes, where: str) -> tuple[F64, F64]:
         pose = np.array([float(v) for v in pose_fields], dtype=np.float64)
     except ValueError:
         raise ValueError(
-            f"{where}:{n + 2}: expected the pose 'x y theta' (3 numbers), "
-            f"got {_show(lines, n + 1)}"
+            f"{where}:{n + 2}: expected the pose 'x y theta' (3 numbers), got {_show(lines, n + 1)}"
         ) from None
     if not np.all(np.isfinite(pose)):
         raise ValueError(f"{where}:{n + 2}: expected a finite pose, got {_show(lines, n + 1)}")

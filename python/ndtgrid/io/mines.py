@@ -116,9 +116,7 @@ def _scans(name: str, first: int) -> Generator[Scan, None, None]:
                 left, right = int(tokens[2]), int(tokens[3])
                 ranges_mm = np.array(tokens[first:need], dtype=np.int64)
             except ValueError:
-                bad = next(
-                    i for i in [0, 2, 3, *range(first, need)] if not _is_int(tokens[i])
-                )
+                bad = next(i for i in [0, 2, 3, *range(first, need)] if not _is_int(tokens[i]))
                 raise ValueError(
                     f"{name}:{number}: token {bad}: expected an integer, got {tokens[bad]!r}"
                 ) from None
@@ -131,7 +129,7 @@ def _scans(name: str, first: int) -> Generator[Scan, None, None]:
             previous = wheels
             yield Scan(
                 timestamp=stamp * 1e-6,
-                ranges=ranges_mm * 1e-3,
+                ranges=ranges_mm.astype(np.float64) * 1e-3,
                 angles=angles,
                 odom=pose,
                 laser_pose=se2.compose(pose, [LASER_OFFSET, 0.0, 0.0]),

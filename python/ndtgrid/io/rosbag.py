@@ -33,8 +33,7 @@ def _rosbags() -> Any:
         from rosbags import highlevel, typesys
     except ImportError as exc:  # pragma: no cover - depends on the environment
         raise ImportError(
-            "reading ROS bags needs the optional 'rosbags' package: "
-            "pip install ndtgrid[rosbag]"
+            "reading ROS bags needs the optional 'rosbags' package: pip install ndtgrid[rosbag]"
         ) from exc
     return highlevel, typesys
 
@@ -163,7 +162,7 @@ def _scans(
             ranges = np.asarray(msg.ranges, dtype=np.float64)
             key = (float(msg.angle_min), float(msg.angle_increment), ranges.shape[0])
             if key not in angle_cache:
-                angle_cache[key] = key[0] + np.arange(key[2]) * key[1]
+                angle_cache[key] = key[0] + np.arange(key[2], dtype=np.float64) * key[1]
             t = _stamp(msg)
             range_max = float(msg.range_max)
             yield Scan(
