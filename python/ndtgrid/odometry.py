@@ -22,8 +22,10 @@ F64 = npt.NDArray[np.float64]
 
 @dataclass(frozen=True)
 class OdometryConfig:
-    """Settings of :class:`Odometry`. Defaults were chosen by measurement on the Intel log
-    (``benches/datasets.py``; see ``BENCHMARK.md``).
+    """Settings of :class:`Odometry` (units: metres, radians).
+
+    Defaults were chosen by measurement on the Freiburg benchmark logs
+    (``benches/datasets.py``; ``BENCHMARK.md`` gives the runs and the numbers).
 
     Attributes
     ----------
@@ -45,8 +47,24 @@ class OdometryConfig:
     min_match_ratio : float, default 0.3
         A match is used when at least this fraction of the scan's valid points found a
         distribution; otherwise the pose is the prediction. In [0, 1].
-    expansion : float, default 10.0
-        ``k`` of eq. (8).
+    rotation_search : float, default 10 degrees
+        Before matching, the score of eq. (1) is evaluated at the prediction turned by
+        ``+-rotation_step, +-2 rotation_step, ...`` up to this [rad], and Newton starts from
+        the best: a 2 cm map's basin is narrow in rotation, and wheel odometry is worst in
+        turns. 0 turns the search off.
+    rotation_step : float, default 1 degree
+        Step of that search [rad]; at least ``rotation_search / 1000``.
+    prior_gap_distance : float, default 0.1
+        When the odometry prior and the constant-velocity prior (the last pose increment)
+        differ by this translation [m] ...
+    prior_gap_angle : float, default 5 degrees
+        ... or this rotation [rad], the scan is matched from both and the match with the
+        higher score of eq. (1) is kept (odometry can stall, then jump). The constant-
+        velocity prior is also tried whenever the match from the odometry prior fails.
+        ``inf`` never, 0 always.
+    expansion : float, default 30.0
+        ``k`` of eq. (8). The paper uses 10; on the benchmark logs (1-degree SICK beams,
+        few points per 2 cm cell) 30 gave lower relation errors (``BENCHMARK.md``).
     neighbor_search : bool, default True
         §IV-A(1) neighbour search.
     fuse_minority : bool, default True
@@ -84,10 +102,13 @@ class Odometry:
     """A scan-to-map odometry loop (in the Rust core).
 
     Per scan: predict the pose (the odometry increment since the last scan when both have
-    odometry, else the last pose increment: constant velocity per scan), match the scan
-    against the map from there (Newton on eq. 1 with §IV-A), and add the scan to the map
-    when the pose moved ``insert_distance`` or turned ``insert_angle`` since the last
-    added scan. The first scan sits at its odometry pose (or the origin) and starts the map.
+    odometry, else the last pose increment: constant velocity per scan), search the
+    rotation around the prediction, match the scan against the map from there (Newton on
+    eq. 1 with §IV-A), fall back to (or, when the two priors disagree, compare with) the
+    constant-velocity prior, and add the scan to the map when the pose moved
+    ``insert_distance`` or turned ``insert_angle`` since the last added scan. The first
+    scan sits at its odometry pose (or the origin) and starts the map. The map keeps the
+    last ``map_window`` added scans' cells (memory bound).
 
     Parameters
     ----------
