@@ -89,7 +89,13 @@ def matrix(p: F64) -> F64:
 class GicpOdometry:
     """small_gicp VGICP scan-to-map odometry in the same loop as ``ndtgrid.Odometry``."""
 
-    def __init__(self, voxels: tuple[float, ...], horizon: int, config: ndtgrid.OdometryConfig):
+    def __init__(
+        self,
+        voxels: tuple[float, ...],
+        horizon: int,
+        config: ndtgrid.OdometryConfig,
+        downsample: float = 0.01,
+    ):
         import small_gicp
 
         self.sg = small_gicp
@@ -97,6 +103,7 @@ class GicpOdometry:
         for m in self.maps:
             m.set_lru(horizon, 10)
         self.cfg = config
+        self.downsample = downsample
         self.poses: list[F64] = []
         self.last_odom: F64 | None = None
         self.last_insert: F64 | None = None
@@ -115,7 +122,9 @@ class GicpOdometry:
     def step(self, scan: Scan) -> F64:
         pts = scan.points(min_range=self.cfg.min_range, max_range=self.cfg.max_range)
         layers = np.vstack([np.c_[pts, np.full(len(pts), z)] for z in (-0.05, 0.0, 0.05)])
-        cloud, _ = self.sg.preprocess_points(layers, downsampling_resolution=0.01, num_neighbors=10)
+        cloud, _ = self.sg.preprocess_points(
+            layers, downsampling_resolution=self.downsample, num_neighbors=10
+        )
         cv = None
         if len(self.poses) >= 2:
             cv = se2.compose(self.poses[-1], se2.between(self.poses[-2], self.poses[-1]))
@@ -145,8 +154,8 @@ class GicpOdometry:
         return pose
 
 
-def run_peer(scans: list[Scan], voxels: tuple[float, ...], horizon: int) -> Run:
-    peer = GicpOdometry(voxels, horizon, ndtgrid.OdometryConfig())
+def run_peer(scans: list[Scan], voxels: tuple[float, ...], horizon: int, ds: float) -> Run:
+    peer = GicpOdometry(voxels, horizon, ndtgrid.OdometryConfig(), ds)
     start = time.perf_counter()
     for k, s in enumerate(scans, start=1):
         peer.step(s)
@@ -201,6 +210,14 @@ def main() -> int:
     parser.add_argument("--no-peer", action="store_true", help="skip small_gicp")
     parser.add_argument("--peer-voxels", default="0.2", help="VGICP voxel sizes, coarse to fine")
     parser.add_argument("--peer-horizon", type=int, default=100, help="LRU horizon [insertions]")
+    parser.add_argument(
+        "--peer-downsample",
+        type=float,
+        default=0.01,
+        help="small_gicp voxel downsampling of each scan [m] (0.01: merges only points "
+        "closer than 1 cm, i.e. no downsampling, as for ndtgrid)",
+    )
+    parser.add_argument("--no-ours", action="store_true", help="skip ndtgrid (peer variants)")
     args = parser.parse_args()
     voxels = tuple(float(v) for v in args.peer_voxels.split(","))
     print(f"machine: {machine()}", file=sys.stderr)
@@ -214,8 +231,12 @@ def main() -> int:
         index = read_benchmark_index(DATA / f"{stem}__index.csv")
         ref = index.corrected
         raw = np.array([s.odom for s in scans])
-        ours = run_ndtgrid(scans)
-        peer = None if args.no_peer else run_peer(scans, voxels, args.peer_horizon)
+        ours = run_ndtgrid(scans) if not args.no_ours else Run(raw.copy(), math.nan)
+        peer = (
+            None
+            if args.no_peer
+            else run_peer(scans, voxels, args.peer_horizon, args.peer_downsample)
+        )
         e_raw = relation_errors(raw[index.raw_scan], ref).summary()
         e_ours = relation_errors(ours.poses[index.raw_scan], ref).summary()
         e_peer = (

@@ -137,6 +137,16 @@ def test_map_on_the_mines_log_with_forced_format(tmp_path: Path) -> None:
     assert times.shape == (200,) and times[0] == pytest.approx(212.387282)
 
 
+def test_readings_beyond_max_range_are_dropped() -> None:
+    from ndtgrid.cli import usable_ranges
+    from ndtgrid.io import Scan
+
+    scan = Scan(0.0, [1.0, 8.0, 9.5, 2.0], [0.0, 0.1, 0.2, 0.3], max_range=8.0)
+    np.testing.assert_array_equal(usable_ranges(scan), [1.0, np.nan, np.nan, 2.0])
+    free = Scan(0.0, [1.0, 9.5], [0.0, 0.1])
+    np.testing.assert_array_equal(usable_ranges(free), [1.0, 9.5])
+
+
 def test_console_script_runs() -> None:
     res = subprocess.run(
         [

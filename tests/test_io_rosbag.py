@@ -133,3 +133,34 @@ def test_topic_choice_errors(tmp_path: Path) -> None:
         list(read_rosbag(only_odom))
     with pytest.raises(FileNotFoundError):
         read_rosbag(tmp_path / "absent.bag")
+
+
+def test_cli_maps_a_bag_and_drops_readings_beyond_range_max(tmp_path: Path) -> None:
+    from ndtgrid.cli import main
+    from ndtgrid.export import read_tum
+
+    from ._room import scan as room_scan
+
+    msgs = []
+    for k in range(20):
+        t = SCAN_T + 0.1 * k
+        pose = np.array([-1.0 + 0.05 * k, -0.5, 0.02 * k])
+        pts = room_scan(pose, beams=181, fov_deg=180.0, noise=0.003, seed=k)
+        ranges = np.hypot(pts[:, 0], pts[:, 1])
+        ranges[::10] = 9.5  # "no return" readings beyond range_max = 8 m
+        scan = laser(t, list(ranges))
+        scan.angle_min, scan.angle_increment = -math.pi / 2, math.pi / 180
+        msgs.append(("/scan", "sensor_msgs/msg/LaserScan", t, scan))
+        msgs.append(("/odom", "nav_msgs/msg/Odometry", t, odometry(t, *pose)))
+    bag = write_bag(tmp_path / "room.bag", 1, msgs)
+    out = tmp_path / "out"
+    assert main(["map", str(bag), "--out", str(out), "--quiet"]) == 0
+    times, poses = read_tum(out / "trajectory.tum")
+    np.testing.assert_allclose(times, SCAN_T + 0.1 * np.arange(20), atol=1e-6)
+    np.testing.assert_allclose(poses[:, 0], -1.0 + 0.05 * np.arange(20), atol=0.01)
+    # No cell of the exported map lies outside the 6 m x 4 m room (the 9.5 m readings
+    # would put points far outside it).
+    from ndtgrid.export import load_map
+
+    centres, _ = load_map(out / "map.npz").cells()
+    assert np.abs(centres[:, 0]).max() < 3.1 and np.abs(centres[:, 1]).max() < 2.1

@@ -23,8 +23,10 @@ from pathlib import Path
 from typing import TypeVar
 
 import numpy as np
+import numpy.typing as npt
 
 from ndtgrid import __version__
+from ndtgrid.io import Scan
 
 T = TypeVar("T")
 
@@ -112,6 +114,14 @@ def _progress(items: Iterable[T], quiet: bool) -> Iterator[T]:
     yield from tqdm(items, unit="scan", desc="mapping", file=sys.stderr)
 
 
+def usable_ranges(scan: Scan) -> npt.NDArray[np.float64]:
+    """The scan's ranges with readings at or beyond its ``max_range`` (e.g. a LaserScan's
+    ``range_max``: no return) replaced by NaN, which the odometry skips; shape (B,) [m]."""
+    if scan.max_range is None:
+        return scan.ranges
+    return np.where(scan.ranges < scan.max_range, scan.ranges, np.nan)
+
+
 def run_map(args: argparse.Namespace) -> int:
     """``ndtgrid map``: see :func:`build_parser`."""
     import itertools
@@ -135,7 +145,7 @@ def run_map(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     for i, scan in enumerate(_progress(scans, args.quiet)):
         prior = scan.laser_pose if scan.laser_pose is not None else scan.odom
-        pose = odo.step(scan.ranges, scan.angles, prior)
+        pose = odo.step(usable_ranges(scan), scan.angles, prior)
         step = odo.last_step
         if step is not None and step.inserted:
             limit = cfg.max_range if scan.max_range is None else min(cfg.max_range, scan.max_range)
