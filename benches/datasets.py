@@ -181,7 +181,22 @@ def log_duration(name: str, index: ndtgrid.io.BenchmarkIndex, n: int) -> float:
 
 
 def fmt(s: RelationSummary) -> str:
-    return f"{s.translation_mean:.3f} ± {s.translation_std:.3f} ({s.translation_max:.2f})"
+    return f"{s.translation_mean:.4f} ± {s.translation_std:.3f} ({s.translation_max:.2f})"
+
+
+def paired(a: F64, b: F64, draws: int = 2000) -> tuple[float, float, float]:
+    """Mean of ``a - b`` over the same relations [m] with a 95 % bootstrap interval."""
+    rng = np.random.default_rng(0)
+    d = a - b
+    means = d[rng.integers(0, d.size, (draws, d.size))].mean(axis=1)
+    lo, hi = np.percentile(means, [2.5, 97.5])
+    return float(d.mean()), float(lo), float(hi)
+
+
+def fmt_paired(p: tuple[float, float, float] | None) -> str:
+    if p is None:
+        return "-"
+    return f"{1e3 * p[0]:+.1f} [{1e3 * p[1]:+.1f}, {1e3 * p[2]:+.1f}]"
 
 
 def fmt_rot(s: RelationSummary) -> str:
@@ -237,11 +252,11 @@ def main() -> int:
             if args.no_peer
             else run_peer(scans, voxels, args.peer_horizon, args.peer_downsample)
         )
-        e_raw = relation_errors(raw[index.raw_scan], ref).summary()
-        e_ours = relation_errors(ours.poses[index.raw_scan], ref).summary()
-        e_peer = (
-            None if peer is None else relation_errors(peer.poses[index.raw_scan], ref).summary()
-        )
+        r_raw = relation_errors(raw[index.raw_scan], ref)
+        r_ours = relation_errors(ours.poses[index.raw_scan], ref)
+        r_peer = None if peer is None else relation_errors(peer.poses[index.raw_scan], ref)
+        e_raw, e_ours = r_raw.summary(), r_ours.summary()
+        e_peer = None if r_peer is None else r_peer.summary()
         n = len(scans)
         duration = log_duration(name, index, n)
         row = {
@@ -257,6 +272,8 @@ def main() -> int:
             "duration": duration,
             "read_s": read_s,
             "published": published,
+            "vs_raw": paired(r_ours.translation, r_raw.translation),
+            "vs_peer": None if r_peer is None else paired(r_ours.translation, r_peer.translation),
         }
         rows.append(row)
         print(f"  raw odometry: {e_raw}\n  ndtgrid:      {e_ours}", file=sys.stderr)
@@ -282,6 +299,14 @@ def main() -> int:
             f"| {fmt(r['ours'])} | {peer_t} | {fmt_rot(r['raw'])} | {fmt_rot(r['ours'])} "
             f"| {peer_r} | {r['ms_ours']:.2f} | {r['ms_peer']:.2f} | {r['published']} |"
         )
+    print(
+        "\nPaired differences of the translational error on the same relations, mean and "
+        "95 % bootstrap interval [mm] (negative: ndtgrid lower):\n"
+    )
+    print("| log | ndtgrid - raw odometry [mm] | ndtgrid - small_gicp [mm] |")
+    print("|---|---|---|")
+    for r in rows:
+        print(f"| {r['label']} | {fmt_paired(r['vs_raw'])} | {fmt_paired(r['vs_peer'])} |")
     print()
     for r in rows:
         span = (
