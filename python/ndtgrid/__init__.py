@@ -35,12 +35,16 @@ from ndtgrid._core import (
     default_match_options,
     ranges_to_points,
 )
+from ndtgrid.odometry import Odometry, OdometryConfig, OdometryStep
 
 __all__ = [
     "Mapper",
     "MapperOptions",
     "MatchResult",
     "NdtGrid",
+    "Odometry",
+    "OdometryConfig",
+    "OdometryStep",
     "RemovalCounts",
     "SmallObject",
     "__version__",

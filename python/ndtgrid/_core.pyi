@@ -262,6 +262,38 @@ class NdtGrid:
         counts : ndarray, shape (K,)
             Point counts ``M``.
         """
+    def cell_states(self) -> tuple[I64Array, I64Array, F64Array, F64Array]:
+        """The exact state of every cell, sorted by index (what a map file stores).
+
+        Returns
+        -------
+        indices : ndarray of int64, shape (K, 2)
+            Integer cell indices ``floor(x / cell_size)``.
+        counts : ndarray of int64, shape (K,)
+            ``M``.
+        sums : ndarray, shape (K, 2)
+            ``m`` about the cell's own centre [m] (the grid's internal form, so
+            nothing is rounded).
+        scatters : ndarray, shape (K, 2, 2)
+            ``S`` about the cell's own centre [m^2].
+        """
+    @staticmethod
+    def from_cell_states(
+        cell_size: float,
+        indices: ArrayLike,
+        counts: ArrayLike,
+        sums: ArrayLike,
+        scatters: ArrayLike,
+    ) -> NdtGrid:
+        """A grid holding exactly the given cell states (see :meth:`cell_states`).
+
+        Raises
+        ------
+        ValueError
+            On an invalid cell size, shapes that disagree, or a cell with a count
+            below 1, a non-finite sum, an index beyond +-2**30 or an index given
+            twice (the message names the cell's position).
+        """
     def cell_statistics(self) -> tuple[I64Array, I64Array, F64Array, F64Array]:
         """The eq. (6) sums of every cell in map coordinates, sorted by index.
 
@@ -651,3 +683,158 @@ def ranges_to_points(
     ValueError
         If the lengths differ, an angle is not finite or the limits are invalid.
     """
+
+class OdometryStep:
+    """What one :meth:`OdometryLoop.step` did; frozen.
+
+    Attributes
+    ----------
+    pose : ndarray, shape (3,)
+        Pose ``[x, y, theta]`` (m, m, rad) the loop settled on.
+    prediction : ndarray, shape (3,)
+        The motion prior the match started from (odometry increment, or constant
+        velocity when there is no odometry or it failed / disagreed and lost).
+    matched : bool
+        A match was run (there was a map and a valid point).
+    accepted : bool
+        The match was used (``num_matched >= min_match_ratio * num_points``);
+        otherwise ``pose`` is the prediction.
+    inserted : bool
+        The scan was added to the map.
+    converged, iterations, num_matched
+        Of the match (False, 0, 0 without one).
+    num_points : int
+        Valid points of the scan.
+    """
+
+    @property
+    def pose(self) -> F64Array: ...
+    @property
+    def prediction(self) -> F64Array: ...
+    @property
+    def matched(self) -> bool: ...
+    @property
+    def accepted(self) -> bool: ...
+    @property
+    def inserted(self) -> bool: ...
+    @property
+    def converged(self) -> bool: ...
+    @property
+    def iterations(self) -> int: ...
+    @property
+    def num_matched(self) -> int: ...
+    @property
+    def num_points(self) -> int: ...
+
+class OdometryLoop:
+    """The core's scan-to-map odometry loop (wrapped by :class:`ndtgrid.Odometry`).
+
+    Keyword arguments left at ``None`` take the core's defaults
+    (:func:`default_odometry_config`); see :class:`ndtgrid.OdometryConfig` for
+    their meaning and units.
+
+    Raises
+    ------
+    ValueError
+        If a setting is out of range (the message names it).
+    """
+
+    def __init__(
+        self,
+        cell_size: float = 0.02,
+        *,
+        min_range: float | None = None,
+        max_range: float | None = None,
+        insert_distance: float | None = None,
+        insert_angle: float | None = None,
+        map_window: int | None = None,
+        min_match_ratio: float | None = None,
+        rotation_search: float | None = None,
+        rotation_step: float | None = None,
+        prior_gap_distance: float | None = None,
+        prior_gap_angle: float | None = None,
+        expansion: float | None = None,
+        neighbor_search: bool | None = None,
+        fuse_minority: bool | None = None,
+        search_radius: int | None = None,
+        max_iterations: int | None = None,
+        max_step_cells: float | None = None,
+        max_step_rotation: float | None = None,
+    ) -> None: ...
+    def step(
+        self, ranges: ArrayLike, angles: ArrayLike, odom: ArrayLike | None = None
+    ) -> OdometryStep:
+        """Process one scan (ranges (B,) [m], angles (B,) [rad], odom (3,) or None).
+
+        Raises
+        ------
+        TypeError, ValueError
+            On a wrong shape or type, lengths that differ, a non-finite angle or
+            odom; the loop is unchanged after an error. The GIL is released.
+        """
+    @property
+    def poses(self) -> F64Array:
+        """Pose of every scan so far, shape (T, 3)."""
+    @property
+    def insertions(self) -> int:
+        """Scans added to the map so far."""
+    def __len__(self) -> int:
+        """Cells in the map now."""
+    def grid(self) -> NdtGrid:
+        """A copy of the map."""
+    def config(self) -> dict[str, Any]:
+        """The settings in force, as keyword arguments (plus ``cell_size``)."""
+
+def default_odometry_config() -> dict[str, Any]:
+    """The core's default :class:`OdometryLoop` settings (with ``cell_size``)."""
+
+class FreeSpace:
+    """Cells crossed by laser beams, for occupancy exports (ROS maps, images).
+
+    Each beam walks the lattice from the sensor to its hit (Amanatides & Woo)
+    and counts one pass in every cell before the hit's own cell.
+
+    Parameters
+    ----------
+    resolution : float, default 0.05
+        Cell size [m].
+
+    Raises
+    ------
+    ValueError
+        If ``resolution`` is not a finite number > 0.
+    """
+
+    def __init__(self, resolution: float = 0.05) -> None: ...
+    @property
+    def resolution(self) -> float:
+        """Cell size [m]."""
+    def __len__(self) -> int:
+        """Cells crossed by at least one beam."""
+    def add_scan(self, points: ArrayLike, pose: ArrayLike) -> None:
+        """Trace the beams from the sensor at ``pose`` (3,) to the scan-frame ``points`` (N, 2) [m].
+
+        Raises
+        ------
+        TypeError, ValueError
+            On a wrong shape, a non-finite value or a coordinate beyond the
+            lattice; nothing changes after an error.
+        """
+    def raster(
+        self, occupied: ArrayLike, *, max_cells: int = 100_000_000
+    ) -> tuple[npt.NDArray[np.int8], F64Array]:
+        """Dense occupancy image covering the traced cells and ``occupied`` (K, 2) points.
+
+        Returns
+        -------
+        image : ndarray of int8, shape (H, W)
+            Row 0 at the lowest y: 100 occupied (a point falls in the cell), 0
+            free (a beam passed), -1 unknown.
+        origin : ndarray, shape (2,)
+            Map-frame position of the outer corner of cell (0, 0) [m].
+
+        Raises
+        ------
+        ValueError
+            If there is nothing to draw, or the image would exceed ``max_cells``.
+        """

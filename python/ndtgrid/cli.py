@@ -1,11 +1,34 @@
-"""The ``ndtgrid`` command line."""
+"""The ``ndtgrid`` command line.
+
+``ndtgrid map LOG --out DIR``
+    Run :class:`ndtgrid.Odometry` over a log and write ``map.png``, a ROS ``map_server`` map
+    (``map.pgm`` + ``map.yaml``), ``trajectory.tum`` and ``map.npz`` (the map's cells; it
+    loads back identical with :func:`ndtgrid.export.load_map` -- a stopgap until the
+    versioned, checksummed map format of a later issue).
+``ndtgrid eval --estimate traj.tum --reference REF``
+    The relation metric of Kümmerle et al. (2009) on consecutive reference poses.
+
+``ndtgrid demo`` (the same on a simulated world) arrives with ``ndtgrid.sim``.
+"""
 
 from __future__ import annotations
 
 import argparse
-from collections.abc import Sequence
+import json
+import math
+import sys
+import time
+from collections.abc import Iterable, Iterator, Sequence
+from pathlib import Path
+from typing import TypeVar
+
+import numpy as np
+import numpy.typing as npt
 
 from ndtgrid import __version__
+from ndtgrid.io import Scan
+
+T = TypeVar("T")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -14,14 +37,179 @@ def build_parser() -> argparse.ArgumentParser:
     Returns
     -------
     argparse.ArgumentParser
-        Parser with ``--version`` and the subcommands.
+        Parser with ``--version`` and the subcommands ``map`` and ``eval``.
     """
+    from ndtgrid.io import LOG_FORMATS
+
     parser = argparse.ArgumentParser(
         prog="ndtgrid",
         description="High-resolution 2D NDT scan matching and grid mapping.",
     )
     parser.add_argument("--version", action="version", version=f"ndtgrid {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    m = sub.add_parser(
+        "map",
+        help="map a real log: map.png, map.pgm + map.yaml, trajectory.tum, map.npz",
+        description="Run the scan-to-map odometry over a log and write the map and trajectory.",
+    )
+    m.add_argument("log", metavar="LOG", help="the log file (or ROS 2 bag directory)")
+    m.add_argument("--out", default="out", help="output directory (default: out)")
+    m.add_argument(
+        "--format",
+        choices=sorted(LOG_FORMATS),
+        help="log format; by default from the name ("
+        + "; ".join(f"{k}: {v}" for k, v in LOG_FORMATS.items())
+        + ")",
+    )
+    m.add_argument("--cell-size", type=float, default=0.02, help="NDT cell size [m] (0.02)")
+    m.add_argument(
+        "--resolution", type=float, default=0.05, help="pixel size of map.pgm/png [m] (0.05)"
+    )
+    m.add_argument("--max-scans", type=int, default=None, help="stop after this many scans")
+    m.add_argument("--quiet", action="store_true", help="no progress bar")
+    e = sub.add_parser(
+        "eval",
+        help="relation error of a trajectory against a reference (Kümmerle et al. 2009)",
+        description="Relation metric on consecutive reference poses: translation [m] and "
+        "rotation [deg], mean ± std and max.",
+    )
+    e.add_argument("--estimate", required=True, help="estimated trajectory (TUM file)")
+    e.add_argument(
+        "--reference",
+        required=True,
+        help="reference: a TUM file, or a benchmark index CSV (its corrected poses)",
+    )
+    e.add_argument(
+        "--reference-time",
+        choices=["auto", "raw_scan", "ipc_ts"],
+        default="auto",
+        help="index CSV column matched with the estimate's timestamps; auto: raw_scan when "
+        "every estimate timestamp is an integer (scan indices, as `ndtgrid map` writes for "
+        "logs without time), else ipc_ts",
+    )
+    e.add_argument(
+        "--max-dt", type=float, default=0.05, help="largest time gap of a matched pose [s]"
+    )
+    e.add_argument("--json", action="store_true", help="print the summary as JSON")
     return parser
+
+
+def _progress(items: Iterable[T], quiet: bool) -> Iterator[T]:
+    """``items`` with a tqdm progress bar on stderr, or a plain counter without tqdm."""
+    if quiet:
+        yield from items
+        return
+    try:
+        from tqdm import tqdm  # type: ignore[import-untyped,unused-ignore]
+    except ImportError:
+        start = time.perf_counter()
+        n = 0
+        for n, item in enumerate(items, start=1):
+            if n % 500 == 0:
+                rate = n / max(time.perf_counter() - start, 1e-9)
+                print(f"\r{n} scans ({rate:.0f} scans/s)", end="", file=sys.stderr)
+            yield item
+        print(f"\r{n} scans", file=sys.stderr)
+        return
+    yield from tqdm(items, unit="scan", desc="mapping", file=sys.stderr)
+
+
+def usable_ranges(scan: Scan) -> npt.NDArray[np.float64]:
+    """The scan's ranges with readings at or beyond its ``max_range`` (e.g. a LaserScan's
+    ``range_max``: no return) replaced by NaN, which the odometry skips; shape (B,) [m]."""
+    if scan.max_range is None:
+        return scan.ranges
+    return np.where(scan.ranges < scan.max_range, scan.ranges, np.nan)
+
+
+def run_map(args: argparse.Namespace) -> int:
+    """``ndtgrid map``: see :func:`build_parser`."""
+    import itertools
+
+    from ndtgrid import NdtGrid, Odometry
+    from ndtgrid._core import FreeSpace
+    from ndtgrid.export import occupancy_image, save_map, write_png, write_ros_map, write_tum
+    from ndtgrid.io import read_log
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    odo = Odometry(cell_size=args.cell_size)
+    cfg = odo.config
+    # The odometry's map is bounded (map_window); the exported map keeps every added scan.
+    full = NdtGrid(args.cell_size)
+    free = FreeSpace(args.resolution)
+    scans = read_log(args.log, format=args.format)
+    if args.max_scans is not None:
+        scans = itertools.islice(scans, args.max_scans)
+    times: list[float] = []
+    start = time.perf_counter()
+    for i, scan in enumerate(_progress(scans, args.quiet)):
+        prior = scan.laser_pose if scan.laser_pose is not None else scan.odom
+        pose = odo.step(usable_ranges(scan), scan.angles, prior)
+        step = odo.last_step
+        if step is not None and step.inserted:
+            limit = cfg.max_range if scan.max_range is None else min(cfg.max_range, scan.max_range)
+            pts = scan.points(min_range=cfg.min_range, max_range=limit)
+            full.insert(pts, pose)
+            free.add_scan(pts, pose)
+        # Logs without time (benchmark splits) get the scan index as timestamp.
+        times.append(scan.timestamp if math.isfinite(scan.timestamp) else float(i))
+    elapsed = time.perf_counter() - start
+    poses = odo.poses
+    if poses.shape[0] == 0:
+        print(f"ndtgrid map: {args.log}: no scans", file=sys.stderr)
+        return 1
+    stamps = np.asarray(times)
+    if np.any(np.diff(stamps) <= 0):  # repeated or unordered stamps: fall back to indices
+        stamps = np.arange(len(times), dtype=np.float64)
+    write_tum(out / "trajectory.tum", stamps, poses)
+    save_map(out / "map.npz", full)
+    centres, _ = full.cells()
+    image = occupancy_image(free, centres)
+    write_ros_map(out / "map.yaml", image)
+    write_png(out / "map.png", image, trajectory=poses, title=Path(args.log).name)
+    print(
+        f"{poses.shape[0]} scans in {elapsed:.1f} s ({1e3 * elapsed / poses.shape[0]:.2f} ms "
+        f"per scan), {odo.insertions} added to the map, {len(full)} cells; wrote "
+        f"map.png, map.pgm, map.yaml, trajectory.tum, map.npz to {out}"
+    )
+    return 0
+
+
+def run_eval(args: argparse.Namespace) -> int:
+    """``ndtgrid eval``: see :func:`build_parser`."""
+    from ndtgrid.evaluation import associate, relation_errors
+    from ndtgrid.export import read_tum
+    from ndtgrid.io import read_benchmark_index
+
+    times, poses = read_tum(args.estimate)
+    if args.reference.endswith(".csv"):
+        index = read_benchmark_index(args.reference)
+        column = args.reference_time
+        if column == "auto":
+            column = "raw_scan" if np.all(times == np.round(times)) else "ipc_ts"
+        ref_times = index.raw_scan.astype(np.float64) if column == "raw_scan" else index.timestamp
+        ref_poses = index.corrected
+    else:
+        ref_times, ref_poses = read_tum(args.reference)
+    match = associate(times, ref_times, max_dt=args.max_dt)
+    ok = match >= 0
+    if ok.sum() < 2:
+        print(
+            f"ndtgrid eval: only {int(ok.sum())} reference poses have an estimate within "
+            f"{args.max_dt} (check --reference-time / --max-dt)",
+            file=sys.stderr,
+        )
+        return 1
+    summary = relation_errors(poses[match[ok]], ref_poses[ok]).summary()
+    if args.json:
+        print(json.dumps(summary.__dict__))
+    else:
+        print(f"relations: {summary}")
+        skipped = int((~ok).sum())
+        if skipped:
+            print(f"({skipped} reference poses without an estimate within {args.max_dt})")
+    return 0
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -38,6 +226,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         Exit status.
     """
     parser = build_parser()
-    parser.parse_args(argv)
+    args = parser.parse_args(argv)
+    if args.command == "map":
+        return run_map(args)
+    if args.command == "eval":
+        return run_eval(args)
     parser.print_help()
     return 0

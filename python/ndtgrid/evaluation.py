@@ -6,6 +6,7 @@ scans with their references and summarises errors.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
@@ -15,7 +16,15 @@ import numpy.typing as npt
 from ndtgrid import se2
 from ndtgrid.io import BenchmarkIndex, Scan
 
-__all__ = ["ScanPair", "corrected_pairs", "pose_error"]
+__all__ = [
+    "RelationErrors",
+    "RelationSummary",
+    "ScanPair",
+    "associate",
+    "corrected_pairs",
+    "pose_error",
+    "relation_errors",
+]
 
 F64 = npt.NDArray[np.float64]
 
@@ -112,3 +121,160 @@ def corrected_pairs(
             true_pose=index.corrected[j],
             guess=se2.compose(index.corrected[i], increment),
         )
+
+
+# ----------------------------------------------------------- relation metric (Kümmerle 2009)
+
+
+@dataclass(frozen=True)
+class RelationSummary:
+    """Summary of relation errors (Kümmerle et al. 2009).
+
+    Attributes
+    ----------
+    n : int
+        Number of relations.
+    translation_mean, translation_std, translation_max : float
+        Mean, standard deviation (population, ``ddof=0``) and maximum of the
+        translational error [m].
+    rotation_mean, rotation_std, rotation_max : float
+        The same for the rotational error [deg].
+    """
+
+    n: int
+    translation_mean: float
+    translation_std: float
+    translation_max: float
+    rotation_mean: float
+    rotation_std: float
+    rotation_max: float
+
+    def __str__(self) -> str:
+        return (
+            f"translation {self.translation_mean:.3f} ± {self.translation_std:.3f} m "
+            f"(max {self.translation_max:.3f}), rotation {self.rotation_mean:.2f} ± "
+            f"{self.rotation_std:.2f} deg (max {self.rotation_max:.2f}), n = {self.n}"
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class RelationErrors:
+    """Per-relation errors of an estimate against a reference.
+
+    Attributes
+    ----------
+    pairs : ndarray of int64, shape (R, 2)
+        Indices ``(i, j)`` of the poses each relation links.
+    translation : ndarray, shape (R,)
+        ``hypot(dx, dy)`` of the component-wise difference ``delta`` [m].
+    rotation : ndarray, shape (R,)
+        ``|dtheta|`` of ``delta``, wrapped to [0, 180] [deg].
+    """
+
+    pairs: npt.NDArray[np.int64]
+    translation: F64
+    rotation: F64
+
+    def summary(self) -> RelationSummary:
+        """Mean ± std and max of both errors (NaN when there is no relation)."""
+
+        def stats(v: F64) -> tuple[float, float, float]:
+            if v.size == 0:
+                return math.nan, math.nan, math.nan
+            return float(v.mean()), float(v.std()), float(v.max())
+
+        t, r = stats(self.translation), stats(self.rotation)
+        return RelationSummary(len(self.translation), *t, *r)
+
+
+def relation_errors(
+    estimate: npt.ArrayLike,
+    reference: npt.ArrayLike,
+    pairs: npt.ArrayLike | None = None,
+) -> RelationErrors:
+    """The relation metric of Kümmerle et al. (2009) on pairs of poses.
+
+    For each pair ``(i, j)`` the relative motions ``est_ij = estimate[i]^-1 o estimate[j]``
+    and ``ref_ij = reference[i]^-1 o reference[j]`` are compared component-wise:
+    ``delta = est_ij - ref_ij`` with the angle wrapped to (-pi, pi]. The translational
+    error is ``hypot(delta_x, delta_y)`` [m], the rotational ``|delta_theta|`` [deg]
+    (the weights ``{1,1,1,0,0,0}`` and ``{0,0,0,1,1,1}`` of the original tool).
+
+    Parameters
+    ----------
+    estimate, reference : array_like, shape (K, 3)
+        Poses ``[x, y, theta]`` (m, m, rad) of the same K instants, each in its own frame
+        (relations do not depend on it).
+    pairs : array_like of int, shape (R, 2), optional
+        Indices of the related poses; by default consecutive ones, ``(i, i + 1)``.
+
+    Returns
+    -------
+    RelationErrors
+        Per-relation errors; ``.summary()`` gives mean ± std, max and n.
+
+    Raises
+    ------
+    ValueError
+        If the shapes differ or are not (K, 3), or a pair index is out of range.
+    """
+    est = np.asarray(estimate, dtype=np.float64)
+    ref = np.asarray(reference, dtype=np.float64)
+    if est.ndim != 2 or est.shape[1:] != (3,) or est.shape != ref.shape:
+        raise ValueError(
+            f"estimate, reference: expected two arrays of the same shape (K, 3), got "
+            f"{est.shape} and {ref.shape}"
+        )
+    k = est.shape[0]
+    if pairs is None:
+        idx = np.stack([np.arange(k - 1), np.arange(1, k)], axis=1).reshape(-1, 2)
+    else:
+        idx = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+        if idx.size and (idx.min() < 0 or idx.max() >= k):
+            raise ValueError(f"pairs: expected indices in [0, {k}), got {idx.min()}..{idx.max()}")
+    trans = np.empty(len(idx))
+    rot = np.empty(len(idx))
+    for n, (i, j) in enumerate(idx):
+        e = se2.between(est[i], est[j])
+        r = se2.between(ref[i], ref[j])
+        # Angle difference wrapped by the core: theta of (0,0,r)^-1 o (0,0,e).
+        dtheta = se2.between([0.0, 0.0, r[2]], [0.0, 0.0, e[2]])[2]
+        trans[n] = math.hypot(e[0] - r[0], e[1] - r[1])
+        rot[n] = abs(math.degrees(dtheta))
+    return RelationErrors(pairs=idx.astype(np.int64), translation=trans, rotation=rot)
+
+
+def associate(
+    times: npt.ArrayLike, reference_times: npt.ArrayLike, *, max_dt: float
+) -> npt.NDArray[np.int64]:
+    """For each reference time, the index of the nearest estimate time.
+
+    Parameters
+    ----------
+    times : array_like, shape (T,)
+        Times of the estimated poses, increasing [s] (or scan indices).
+    reference_times : array_like, shape (K,)
+        Times of the reference poses.
+    max_dt : float
+        Largest admissible gap [same unit].
+
+    Returns
+    -------
+    ndarray of int64, shape (K,)
+        Index into ``times`` per reference time, or -1 where the nearest is farther than
+        ``max_dt``.
+
+    Raises
+    ------
+    ValueError
+        If ``times`` is empty or not increasing.
+    """
+    t = np.asarray(times, dtype=np.float64)
+    ref = np.asarray(reference_times, dtype=np.float64)
+    if t.size == 0 or np.any(np.diff(t) < 0) or not np.all(np.isfinite(t)):
+        raise ValueError("times: expected finite, non-decreasing times, at least one")
+    right = np.clip(np.searchsorted(t, ref), 0, t.size - 1)
+    left = np.clip(right - 1, 0, t.size - 1)
+    nearest = np.where(np.abs(t[left] - ref) <= np.abs(t[right] - ref), left, right)
+    ok = np.abs(t[nearest] - ref) <= max_dt
+    return np.where(ok, nearest, -1).astype(np.int64)

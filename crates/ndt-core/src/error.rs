@@ -62,6 +62,25 @@ pub enum NdtError {
         /// The value that came.
         value: f64,
     },
+    /// A stored cell (see [`crate::NdtGrid::from_cell_states`]) that no grid
+    /// can hold.
+    #[error("cells: cell {index} {reason}")]
+    InvalidCell {
+        /// Position of the cell in the input.
+        index: usize,
+        /// What is wrong with it, in words.
+        reason: &'static str,
+    },
+    /// An output that would be larger than the stated limit.
+    #[error("{what}: {size} would exceed the limit of {limit}")]
+    TooLarge {
+        /// What would be too large.
+        what: &'static str,
+        /// Its size.
+        size: u64,
+        /// The limit.
+        limit: u64,
+    },
 }
 
 /// Displays a number plainly, or in scientific notation when it is very large

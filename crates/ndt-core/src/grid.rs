@@ -13,6 +13,8 @@ use crate::key::{CellKey, MAX_INDEX};
 use crate::pyramid::{Level, Pyramid, MAX_LEVELS};
 use crate::se2::Pose2;
 
+mod edit;
+
 /// How many prepared distribution sets (one per pyramid level and distinct
 /// expansion/fusion setting) a grid keeps between calls.
 const PREPARED_CAPACITY: usize = 24;

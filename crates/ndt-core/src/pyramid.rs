@@ -80,64 +80,51 @@ impl Pyramid {
         &self.levels[0]
     }
 
-    /// eq. (6) on every level for map-frame points `w` whose fine keys are
-    /// given. Scan points come in beam order, so runs of points in the same
-    /// coarse cell are summed first and added with one look-up.
+    /// eq. (6) on the fine level for map-frame points `w` whose fine keys
+    /// are given (scan points come in beam order, so runs of points in the
+    /// same cell are summed first and added with one look-up); then every
+    /// coarser cell above a changed one is re-summed from its 4 children, so
+    /// each level is a function of the fine cells alone (the same however the
+    /// points were batched, and bit for bit the same after a save and load).
     ///
     /// Returns, per level, the keys of the cells that changed.
     pub fn add(&mut self, staged: &[(CellKey, Vector2<f64>)]) -> Vec<Vec<CellKey>> {
-        let mut touched_all = Vec::with_capacity(self.levels.len());
-        for (l, level) in self.levels.iter_mut().enumerate() {
-            let mut seen = FxHashSet::default();
-            let mut touched = Vec::new();
-            let mut flush = |key: CellKey, run: &CellStats| {
-                level.cells.entry(key).or_default().merge(run);
-                if seen.insert(key) {
-                    touched.push(key);
-                }
-            };
-            let mut run: Option<(CellKey, CellStats)> = None;
-            for &(fine, w) in staged {
-                let key = coarse_key(fine, l);
-                let centre = key.center(level.cell_size);
-                match &mut run {
-                    Some((k, stats)) if *k == key => stats.add_point(w - centre),
-                    _ => {
-                        if let Some((k, stats)) = run.take() {
-                            flush(k, &stats);
-                        }
-                        let mut stats = CellStats::default();
-                        stats.add_point(w - centre);
-                        run = Some((key, stats));
-                    }
-                }
-            }
-            if let Some((k, stats)) = run {
-                flush(k, &stats);
-            }
-            touched_all.push(touched);
-        }
-        touched_all
-    }
-}
-
-impl Pyramid {
-    /// Removes the fine cells `keys` and their sums from every coarser level.
-    /// A coarse cell is recomputed as the sum of its 4 children on the level
-    /// below (exact, no subtraction drift), and dropped when they are all gone.
-    ///
-    /// Returns, per level, the keys of the cells that changed (level 0: the
-    /// fine cells actually removed).
-    pub fn remove(&mut self, keys: &[CellKey]) -> Vec<Vec<CellKey>> {
-        let mut touched_all: Vec<Vec<CellKey>> = Vec::with_capacity(self.levels.len());
+        let fine = &mut self.levels[0];
         let mut seen = FxHashSet::default();
-        let mut removed = Vec::new();
-        for &key in keys {
-            if seen.insert(key) && self.levels[0].cells.remove(&key).is_some() {
-                removed.push(key);
+        let mut touched = Vec::new();
+        let mut run: Option<(CellKey, CellStats)> = None;
+        let mut flush = |key: CellKey, stats: &CellStats| {
+            fine.cells.entry(key).or_default().merge(stats);
+            if seen.insert(key) {
+                touched.push(key);
+            }
+        };
+        for &(key, w) in staged {
+            let centre = key.center(fine.cell_size);
+            match &mut run {
+                Some((k, stats)) if *k == key => stats.add_point(w - centre),
+                _ => {
+                    if let Some((k, stats)) = run.take() {
+                        flush(k, &stats);
+                    }
+                    let mut stats = CellStats::default();
+                    stats.add_point(w - centre);
+                    run = Some((key, stats));
+                }
             }
         }
-        touched_all.push(removed);
+        if let Some((k, stats)) = run {
+            flush(k, &stats);
+        }
+        self.refresh_parents(touched)
+    }
+
+    /// Re-sums, level by level, every coarse cell above the changed fine
+    /// cells `fine` from its 4 children on the level below (in a fixed order),
+    /// dropping it when they are all gone. Returns the changed keys per level.
+    fn refresh_parents(&mut self, fine: Vec<CellKey>) -> Vec<Vec<CellKey>> {
+        let mut touched_all: Vec<Vec<CellKey>> = Vec::with_capacity(self.levels.len());
+        touched_all.push(fine);
         for l in 1..self.levels.len() {
             let mut parents = FxHashSet::default();
             let mut changed = Vec::new();
@@ -171,5 +158,35 @@ impl Pyramid {
             touched_all.push(changed);
         }
         touched_all
+    }
+}
+
+impl Pyramid {
+    /// Removes the fine cells `keys` and their sums from every coarser level
+    /// (coarse cells re-summed from their children, see [`Pyramid::add`]).
+    ///
+    /// Returns, per level, the keys of the cells that changed (level 0: the
+    /// fine cells actually removed).
+    pub fn remove(&mut self, keys: &[CellKey]) -> Vec<Vec<CellKey>> {
+        let mut seen = FxHashSet::default();
+        let mut removed = Vec::new();
+        for &key in keys {
+            if seen.insert(key) && self.levels[0].cells.remove(&key).is_some() {
+                removed.push(key);
+            }
+        }
+        self.refresh_parents(removed)
+    }
+}
+
+impl Pyramid {
+    /// Replaces every level: the fine level holds exactly `states` (sums about
+    /// each cell's centre) and each coarser level is summed from the one below.
+    pub fn set_fine(&mut self, states: &[(CellKey, CellStats)]) {
+        self.levels[0].cells = states.iter().copied().collect();
+        for level in &mut self.levels[1..] {
+            level.cells.clear();
+        }
+        self.refresh_parents(states.iter().map(|(k, _)| *k).collect());
     }
 }

@@ -32,6 +32,14 @@ pub struct PyNdtGrid {
     inner: Arc<RwLock<NdtGrid>>,
 }
 
+impl From<NdtGrid> for PyNdtGrid {
+    fn from(grid: NdtGrid) -> Self {
+        Self {
+            inner: Arc::new(RwLock::new(grid)),
+        }
+    }
+}
+
 impl PyNdtGrid {
     /// A Python handle on a grid shared with its owner (the mapper).
     pub(crate) fn shared(inner: Arc<RwLock<NdtGrid>>) -> Self {
@@ -263,6 +271,24 @@ impl PyNdtGrid {
             PyArray1::from_vec(py, sums).reshape([k, 2])?,
             PyArray1::from_vec(py, scatters).reshape([k, 2, 2])?,
         ))
+    }
+
+    /// The exact cell state (sums about each cell's centre), sorted by index.
+    fn cell_states<'py>(&self, py: Python<'py>) -> PyResult<crate::state::StateArrays<'py>> {
+        let v = self.read(py, crate::state::flatten)?;
+        crate::state::to_arrays(py, v)
+    }
+
+    /// A grid holding exactly the given cell states.
+    #[staticmethod]
+    fn from_cell_states(
+        cell_size: f64,
+        indices: &Bound<'_, PyAny>,
+        counts: &Bound<'_, PyAny>,
+        sums: &Bound<'_, PyAny>,
+        scatters: &Bound<'_, PyAny>,
+    ) -> PyResult<Self> {
+        crate::state::from_arrays(cell_size, indices, counts, sums, scatters).map(Self::from)
     }
 }
 

@@ -4,13 +4,16 @@
 
 mod convert;
 mod errors;
+mod freespace;
 mod grid;
 mod mapper;
 mod mapper_options;
+mod odometry;
 mod ranges;
 mod result;
 mod se2;
 mod small_object;
+mod state;
 
 use pyo3::prelude::*;
 
@@ -24,6 +27,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<small_object::PySmallObject>()?;
     m.add_class::<small_object::PyRemovalCounts>()?;
     m.add_function(wrap_pyfunction!(mapper_options::default_mapper_options, m)?)?;
+    m.add_class::<odometry::PyOdometry>()?;
+    m.add_class::<odometry::PyStep>()?;
+    m.add_class::<freespace::PyFreeSpace>()?;
+    m.add_function(wrap_pyfunction!(odometry::default_odometry_config, m)?)?;
     m.add_function(wrap_pyfunction!(grid::default_match_options, m)?)?;
     m.add_function(wrap_pyfunction!(ranges::ranges_to_points, m)?)?;
     m.add_function(wrap_pyfunction!(se2::compose, m)?)?;

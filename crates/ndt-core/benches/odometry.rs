@@ -1,0 +1,52 @@
+//! `cargo bench --bench odometry`: one step of the scan-to-map odometry loop
+//! (prediction, rotation search, match, insertion, map window) on a 181-beam
+//! SICK-like scan of the synthetic room, with the default settings (2 cm).
+//!
+//! The loop first runs along a 60-scan path; each measured step then processes
+//! the next scan of the path from a clone of that loop.
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use ndt_core::{Odometry, OdometryConfig, Pose2};
+
+fn polar(pose: Pose2, seed: u64) -> (Vec<f64>, Vec<f64>) {
+    let pts = common::scan(&common::room(), pose, 181, std::f64::consts::PI, 0.01, seed);
+    pts.iter()
+        .map(|p| (p[0].hypot(p[1]), p[1].atan2(p[0])))
+        .unzip()
+}
+
+fn path(k: u32) -> Pose2 {
+    let t = f64::from(k);
+    Pose2::new(
+        -1.5 + 0.04 * t,
+        -0.8 + 0.3 * (t / 12.0).sin(),
+        0.4 * (t / 15.0).sin(),
+    )
+}
+
+fn bench_step(c: &mut Criterion) {
+    let mut odo = Odometry::new(OdometryConfig::default()).unwrap_or_else(|e| panic!("{e}"));
+    for k in 0..60 {
+        let (r, a) = polar(path(k), u64::from(k));
+        let odom = path(k).compose(Pose2::new(0.0, 0.0, 0.002 * f64::from(k)));
+        odo.step(&r, &a, Some(odom))
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
+    let (r, a) = polar(path(60), 60);
+    let odom = path(60).compose(Pose2::new(0.0, 0.0, 0.12));
+    c.bench_function("odometry_step_181_beams_2cm", |b| {
+        b.iter_batched_ref(
+            || odo.clone(),
+            |o| o.step(black_box(&r), black_box(&a), Some(odom)),
+            BatchSize::LargeInput,
+        )
+    });
+}
+
+criterion_group!(benches, bench_step);
+criterion_main!(benches);

@@ -1,0 +1,100 @@
+//! The scan-to-map odometry loop: priors, tracking, memory bound, bad input.
+
+use ndt_core::{NdtError, Odometry, OdometryConfig, Pose2};
+/// Ranges of a beam fan at `pose` inside the square `[-2, 2]²`.
+fn square_scan(pose: Pose2, beams: usize) -> (Vec<f64>, Vec<f64>) {
+    let angles: Vec<f64> = (0..beams)
+        .map(|i| -1.5 + 3.0 * i as f64 / (beams - 1) as f64)
+        .collect();
+    let ranges = angles
+        .iter()
+        .map(|a| {
+            let (s, c) = (pose.theta + a).sin_cos();
+            let tx = if c > 0.0 {
+                (2.0 - pose.x) / c
+            } else {
+                (-2.0 - pose.x) / c
+            };
+            let ty = if s > 0.0 {
+                (2.0 - pose.y) / s
+            } else {
+                (-2.0 - pose.y) / s
+            };
+            tx.min(ty)
+        })
+        .collect();
+    (ranges, angles)
+}
+
+#[test]
+fn prediction_follows_odometry_then_constant_velocity() {
+    let config = OdometryConfig {
+        insert_distance: 100.0,
+        insert_angle: 10.0,
+        ..OdometryConfig::default()
+    };
+    let mut odo = Odometry::new(config).unwrap();
+    // No valid beam: every pose is the prediction.
+    let (r, a) = (vec![0.0; 3], vec![0.0, 0.1, 0.2]);
+    let o0 = Pose2::new(1.0, 2.0, 0.5);
+    let s0 = odo.step(&r, &a, Some(o0)).unwrap();
+    assert_eq!(s0.pose, o0);
+    let o1 = o0.compose(Pose2::new(0.1, 0.0, 0.05));
+    let s1 = odo.step(&r, &a, Some(o1)).unwrap();
+    assert!((s1.pose.x - o1.x).abs() < 1e-12 && (s1.pose.theta - o1.theta).abs() < 1e-12);
+    let s2 = odo.step(&r, &a, None).unwrap();
+    let expected = o1.compose(Pose2::new(0.1, 0.0, 0.05));
+    assert!((s2.pose.x - expected.x).abs() < 1e-12);
+    assert!((s2.pose.y - expected.y).abs() < 1e-12);
+    assert_eq!(odo.poses().len(), 3);
+    assert_eq!(odo.insertions(), 0);
+}
+
+#[test]
+fn tracks_a_moving_sensor_and_bounds_the_map() {
+    let config = OdometryConfig {
+        map_window: 3,
+        insert_distance: 0.05,
+        ..OdometryConfig::default()
+    };
+    let mut odo = Odometry::new(config).unwrap();
+    let mut max_cells = 0;
+    for i in 0..40 {
+        let t = f64::from(i);
+        let truth = Pose2::new(0.02 * t, 0.01 * t, 0.01 * t);
+        let (r, a) = square_scan(truth, 361);
+        // No odometry: the constant-velocity prior, corrected by matching.
+        let out = odo.step(&r, &a, None).unwrap();
+        let d = truth.between(out.pose);
+        assert!(d.x.hypot(d.y) < 0.01, "scan {i}: {:?}", out.pose);
+        assert!(d.theta.abs() < 0.005, "scan {i}: {:?}", out.pose);
+        max_cells = max_cells.max(odo.grid().len());
+    }
+    assert!(odo.insertions() >= 10);
+    assert!(max_cells <= 3 * 361);
+}
+
+#[test]
+fn bad_input_leaves_the_loop_unchanged() {
+    let mut odo = Odometry::new(OdometryConfig::default()).unwrap();
+    let (r, a) = square_scan(Pose2::identity(), 90);
+    odo.step(&r, &a, None).unwrap();
+    let cells = odo.grid().len();
+    assert!(odo.step(&r, &a[1..], None).is_err());
+    let bad = Pose2 {
+        x: f64::NAN,
+        y: 0.0,
+        theta: 0.0,
+    };
+    assert!(matches!(
+        odo.step(&r, &a, Some(bad)),
+        Err(NdtError::NonFinite { what: "odom", .. })
+    ));
+    assert_eq!(odo.poses().len(), 1);
+    assert_eq!(odo.grid().len(), cells);
+    let config = OdometryConfig {
+        min_match_ratio: 1.5,
+        ..OdometryConfig::default()
+    };
+    assert!(Odometry::new(config).is_err());
+}

@@ -1,0 +1,257 @@
+//! `ndtgrid._core.OdometryLoop`: the core's scan-to-map odometry loop, and
+//! `OdometryStep`, the record of one step. The Python class
+//! `ndtgrid.Odometry` wraps them with a dataclass config.
+
+use std::sync::Mutex;
+
+use ndt_core::{MatchOptions, Odometry, OdometryConfig, Pose2, StepOutcome};
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::{count, pose, vec3, vector};
+use crate::errors::{poisoned, to_py};
+use crate::grid::PyNdtGrid;
+
+/// The scan-to-map odometry loop (see the stub for the documentation).
+#[pyclass(name = "OdometryLoop", module = "ndtgrid._core", frozen)]
+pub struct PyOdometry {
+    inner: Mutex<Odometry>,
+}
+
+/// One step of the loop (see the stub for field docs).
+#[pyclass(name = "OdometryStep", module = "ndtgrid._core", frozen)]
+pub struct PyStep {
+    pose: [f64; 3],
+    prediction: [f64; 3],
+    #[pyo3(get)]
+    matched: bool,
+    #[pyo3(get)]
+    accepted: bool,
+    #[pyo3(get)]
+    inserted: bool,
+    #[pyo3(get)]
+    converged: bool,
+    #[pyo3(get)]
+    iterations: u32,
+    #[pyo3(get)]
+    num_matched: usize,
+    #[pyo3(get)]
+    num_points: usize,
+}
+
+impl From<StepOutcome> for PyStep {
+    fn from(s: StepOutcome) -> Self {
+        Self {
+            pose: s.pose.to_array(),
+            prediction: s.prediction.to_array(),
+            matched: s.matched.is_some(),
+            accepted: s.accepted,
+            inserted: s.inserted,
+            converged: s.matched.as_ref().is_some_and(|m| m.converged),
+            iterations: s.matched.as_ref().map_or(0, |m| m.iterations),
+            num_matched: s.matched.as_ref().map_or(0, |m| m.num_matched),
+            num_points: s.num_points,
+        }
+    }
+}
+
+#[pymethods]
+impl PyStep {
+    /// `(3,)` pose of the scan.
+    #[getter]
+    fn pose<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vec3(py, self.pose)
+    }
+
+    /// `(3,)` prediction of the motion prior.
+    #[getter]
+    fn prediction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vec3(py, self.prediction)
+    }
+
+    fn __repr__(&self) -> String {
+        let [x, y, t] = self.pose;
+        let b = |v: bool| if v { "True" } else { "False" };
+        format!(
+            "OdometryStep(pose=[{x:.6}, {y:.6}, {t:.6}], accepted={}, inserted={}, \
+             converged={}, iterations={}, num_matched={}, num_points={})",
+            b(self.accepted),
+            b(self.inserted),
+            b(self.converged),
+            self.iterations,
+            self.num_matched,
+            self.num_points
+        )
+    }
+}
+
+impl PyOdometry {
+    fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, Odometry>> {
+        self.inner.lock().map_err(|_| poisoned())
+    }
+}
+
+#[pymethods]
+impl PyOdometry {
+    #[new]
+    #[pyo3(signature = (
+        cell_size = 0.02, *, min_range = None, max_range = None, insert_distance = None,
+        insert_angle = None, map_window = None, min_match_ratio = None, rotation_search = None,
+        rotation_step = None, prior_gap_distance = None, prior_gap_angle = None,
+        expansion = None,
+        neighbor_search = None, fuse_minority = None, search_radius = None,
+        max_iterations = None, max_step_cells = None, max_step_rotation = None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        cell_size: f64,
+        min_range: Option<f64>,
+        max_range: Option<f64>,
+        insert_distance: Option<f64>,
+        insert_angle: Option<f64>,
+        map_window: Option<i64>,
+        min_match_ratio: Option<f64>,
+        rotation_search: Option<f64>,
+        rotation_step: Option<f64>,
+        prior_gap_distance: Option<f64>,
+        prior_gap_angle: Option<f64>,
+
+        expansion: Option<f64>,
+        neighbor_search: Option<bool>,
+        fuse_minority: Option<bool>,
+        search_radius: Option<i64>,
+        max_iterations: Option<i64>,
+        max_step_cells: Option<f64>,
+        max_step_rotation: Option<f64>,
+    ) -> PyResult<Self> {
+        let d = OdometryConfig::default();
+        let m = d.matcher;
+        let window = map_window
+            .map(|w| count("map_window", w))
+            .transpose()?
+            .map_or(d.map_window, |w| w as usize);
+        let matcher = MatchOptions {
+            expansion: expansion.unwrap_or(m.expansion),
+            neighbor_search: neighbor_search.unwrap_or(m.neighbor_search),
+            fuse_minority: fuse_minority.unwrap_or(m.fuse_minority),
+            search_radius: search_radius
+                .map(|r| count("search_radius", r))
+                .transpose()?
+                .unwrap_or(m.search_radius),
+            max_iterations: max_iterations
+                .map(|r| count("max_iterations", r))
+                .transpose()?
+                .unwrap_or(m.max_iterations),
+            max_step_cells: max_step_cells.unwrap_or(m.max_step_cells),
+            max_step_rotation: max_step_rotation.unwrap_or(m.max_step_rotation),
+            ..m
+        };
+        let config = OdometryConfig {
+            cell_size,
+            min_range: min_range.unwrap_or(d.min_range),
+            max_range: max_range.unwrap_or(d.max_range),
+            insert_distance: insert_distance.unwrap_or(d.insert_distance),
+            insert_angle: insert_angle.unwrap_or(d.insert_angle),
+            map_window: window,
+            min_match_ratio: min_match_ratio.unwrap_or(d.min_match_ratio),
+            rotation_search: rotation_search.unwrap_or(d.rotation_search),
+            rotation_step: rotation_step.unwrap_or(d.rotation_step),
+            prior_gap_distance: prior_gap_distance.unwrap_or(d.prior_gap_distance),
+            prior_gap_angle: prior_gap_angle.unwrap_or(d.prior_gap_angle),
+
+            matcher,
+        };
+        Ok(Self {
+            inner: Mutex::new(Odometry::new(config).map_err(to_py)?),
+        })
+    }
+
+    /// Processes one scan; returns what was done.
+    #[pyo3(signature = (ranges, angles, odom = None))]
+    fn step(
+        &self,
+        py: Python<'_>,
+        ranges: &Bound<'_, PyAny>,
+        angles: &Bound<'_, PyAny>,
+        odom: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyStep> {
+        let r = vector(ranges, "ranges")?;
+        let a = vector(angles, "angles")?;
+        let (r, a) = (r.as_slice()?, a.as_slice()?);
+        let o = odom.map(|o| pose(o, "odom")).transpose()?.map(|p| Pose2 {
+            x: p[0],
+            y: p[1],
+            theta: p[2],
+        });
+        py.detach(|| {
+            let mut odo = self.lock()?;
+            odo.step(r, a, o).map_err(to_py)
+        })
+        .map(PyStep::from)
+    }
+
+    /// `(T, 3)` pose of every scan so far.
+    #[getter]
+    fn poses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let flat: Vec<f64> = {
+            let odo = self.lock()?;
+            odo.poses().iter().flat_map(|p| p.to_array()).collect()
+        };
+        let t = flat.len() / 3;
+        PyArray1::from_vec(py, flat).reshape([t, 3])
+    }
+
+    /// Scans added to the map so far.
+    #[getter]
+    fn insertions(&self) -> PyResult<u64> {
+        Ok(self.lock()?.insertions())
+    }
+
+    /// Cells in the map now.
+    fn __len__(&self) -> PyResult<usize> {
+        Ok(self.lock()?.grid().len())
+    }
+
+    /// A copy of the map.
+    fn grid(&self, py: Python<'_>) -> PyResult<PyNdtGrid> {
+        let grid = py.detach(|| self.lock().map(|o| o.grid().clone()))?;
+        Ok(PyNdtGrid::from(grid))
+    }
+
+    /// The settings in force, as keyword arguments of the constructor.
+    fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let c = *self.lock()?.config();
+        config_dict(py, &c)
+    }
+}
+
+fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    out.set_item("cell_size", c.cell_size)?;
+    out.set_item("min_range", c.min_range)?;
+    out.set_item("max_range", c.max_range)?;
+    out.set_item("insert_distance", c.insert_distance)?;
+    out.set_item("insert_angle", c.insert_angle)?;
+    out.set_item("map_window", c.map_window)?;
+    out.set_item("min_match_ratio", c.min_match_ratio)?;
+    out.set_item("rotation_search", c.rotation_search)?;
+    out.set_item("rotation_step", c.rotation_step)?;
+    out.set_item("prior_gap_distance", c.prior_gap_distance)?;
+    out.set_item("prior_gap_angle", c.prior_gap_angle)?;
+
+    out.set_item("expansion", c.matcher.expansion)?;
+    out.set_item("neighbor_search", c.matcher.neighbor_search)?;
+    out.set_item("fuse_minority", c.matcher.fuse_minority)?;
+    out.set_item("search_radius", c.matcher.search_radius)?;
+    out.set_item("max_iterations", c.matcher.max_iterations)?;
+    out.set_item("max_step_cells", c.matcher.max_step_cells)?;
+    out.set_item("max_step_rotation", c.matcher.max_step_rotation)?;
+    Ok(out)
+}
+
+/// The core's default odometry settings (keyword arguments of `OdometryLoop`).
+#[pyfunction]
+pub fn default_odometry_config(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    config_dict(py, &OdometryConfig::default())
+}

@@ -1,0 +1,221 @@
+"""Scan-to-map odometry: match each scan to the map built so far, then add it to the map.
+
+The loop runs in the Rust core (``ndtgrid._core.OdometryLoop``); this module gives it a
+typed configuration with units and the Python surface of ``docs/API.md``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from ndtgrid._core import NdtGrid, OdometryLoop, OdometryStep
+
+__all__ = ["Odometry", "OdometryConfig", "OdometryStep"]
+
+F64 = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class OdometryConfig:
+    """Settings of :class:`Odometry` (units: metres, radians).
+
+    Defaults were chosen by measurement on the Freiburg benchmark logs
+    (``benches/datasets.py``; ``BENCHMARK.md`` gives the runs and the numbers).
+
+    Attributes
+    ----------
+    min_range : float, default 0.0
+        Beams shorter than this are skipped [m].
+    max_range : float, default 30.0
+        Beams at or beyond this are skipped [m]: the "no return" readings of a SICK
+        (81.83 m) and far, sparse returns.
+    insert_distance : float, default 0.1
+        A scan is added to the map when the pose moved this far since the last added
+        scan [m] ...
+    insert_angle : float, default 5 degrees
+        ... or turned this much [rad].
+    map_window : int, default 200
+        Memory bound: the map keeps the cells hit by the last ``map_window`` added scans (a
+        cell hit again stays, with all its points), so at most ``map_window * B`` cells for
+        ``B``-beam scans however long the run; 0 keeps every cell (memory then grows with
+        the mapped area, and with the drift when a place is revisited).
+    min_match_ratio : float, default 0.3
+        A match is used when at least this fraction of the scan's valid points found a
+        distribution; otherwise the pose is the prediction. In [0, 1].
+    rotation_search : float, default 10 degrees
+        Before matching, the score of eq. (1) is evaluated at the prediction turned by
+        ``+-rotation_step, +-2 rotation_step, ...`` up to this [rad], and Newton starts from
+        the best: a 2 cm map's basin is narrow in rotation, and wheel odometry is worst in
+        turns. 0 turns the search off.
+    rotation_step : float, default 1 degree
+        Step of that search [rad]; at least ``rotation_search / 1000``.
+    prior_gap_distance : float, default 0.1
+        When the odometry prior and the constant-velocity prior (the last pose increment)
+        differ by this translation [m] ...
+    prior_gap_angle : float, default 5 degrees
+        ... or this rotation [rad], the scan is matched from both and the match with the
+        higher score of eq. (1) is kept (odometry can stall, then jump). The constant-
+        velocity prior is also tried whenever the match from the odometry prior fails.
+        ``inf`` never, 0 always.
+    expansion : float, default 30.0
+        ``k`` of eq. (8). The paper uses 10; on the benchmark logs (1-degree SICK beams,
+        few points per 2 cm cell) 30 gave lower relation errors (``BENCHMARK.md``).
+    neighbor_search : bool, default True
+        §IV-A(1) neighbour search.
+    fuse_minority : bool, default True
+        §IV-A(3) fusion of cells with fewer than 3 points.
+    search_radius : int, default 3
+        Neighbour-search radius [cells].
+    max_iterations : int, default 50
+        Newton steps per scan at most.
+    max_step_cells : float, default 2.0
+        Largest translation per Newton step [cells].
+    max_step_rotation : float, default 0.05
+        Largest rotation per Newton step [rad].
+    """
+
+    min_range: float = 0.0
+    max_range: float = 30.0
+    insert_distance: float = 0.1
+    insert_angle: float = math.radians(5.0)
+    map_window: int = 200
+    min_match_ratio: float = 0.3
+    rotation_search: float = math.radians(10.0)
+    rotation_step: float = math.radians(1.0)
+    prior_gap_distance: float = 0.1
+    prior_gap_angle: float = math.radians(5.0)
+    expansion: float = 30.0
+    neighbor_search: bool = True
+    fuse_minority: bool = True
+    search_radius: int = 3
+    max_iterations: int = 50
+    max_step_cells: float = 2.0
+    max_step_rotation: float = 0.05
+
+
+class Odometry:
+    """A scan-to-map odometry loop (in the Rust core).
+
+    Per scan: predict the pose (the odometry increment since the last scan when both have
+    odometry, else the last pose increment: constant velocity per scan), search the
+    rotation around the prediction, match the scan against the map from there (Newton on
+    eq. 1 with §IV-A), fall back to (or, when the two priors disagree, compare with) the
+    constant-velocity prior, and add the scan to the map when the pose moved
+    ``insert_distance`` or turned ``insert_angle`` since the last added scan. The first
+    scan sits at its odometry pose (or the origin) and starts the map. The map keeps the
+    last ``map_window`` added scans' cells (memory bound).
+
+    Parameters
+    ----------
+    cell_size : float, default 0.02
+        Side of the map's cells [m] (the paper: 2 cm).
+    config : OdometryConfig, optional
+        The other settings, with units; defaults as documented there.
+
+    Raises
+    ------
+    ValueError
+        If a setting is out of range (the message names it).
+
+    Notes
+    -----
+    ``odo.mapper`` (the §V outlier elimination of ``ndtgrid.Mapper``) arrives with the
+    Mapper; until then the map is a plain :class:`~ndtgrid.NdtGrid` (a copy: :meth:`grid`).
+    Every map change goes through one function of the core, ``Odometry::update_map``.
+
+    Examples
+    --------
+    >>> import numpy as np, ndtgrid
+    >>> odo = ndtgrid.Odometry(cell_size=0.02)
+    >>> angles = np.linspace(-np.pi / 2, np.pi / 2, 181)
+    >>> pose = odo.step(np.full(181, 2.0), angles)
+    >>> odo.poses.shape
+    (1, 3)
+    """
+
+    def __init__(self, cell_size: float = 0.02, config: OdometryConfig | None = None) -> None:
+        self._config = OdometryConfig() if config is None else config
+        if not isinstance(self._config, OdometryConfig):
+            raise TypeError(
+                f"config: expected an OdometryConfig, got {type(self._config).__name__}"
+            )
+        self._loop = OdometryLoop(cell_size, **dataclasses.asdict(self._config))
+        self._last: OdometryStep | None = None
+
+    @property
+    def cell_size(self) -> float:
+        """Side of the map's cells [m]."""
+        return float(self._loop.config()["cell_size"])
+
+    @property
+    def config(self) -> OdometryConfig:
+        """The settings."""
+        return self._config
+
+    def step(
+        self, ranges: npt.ArrayLike, angles: npt.ArrayLike, odom: npt.ArrayLike | None = None
+    ) -> F64:
+        """Process one scan and return its pose.
+
+        Parameters
+        ----------
+        ranges : array_like, shape (B,)
+            Ranges [m]; invalid ones (0, NaN, inf, outside ``[min_range, max_range)``) are
+            skipped.
+        angles : array_like, shape (B,)
+            Beam angles in the sensor frame [rad].
+        odom : array_like, shape (3,), optional
+            Odometry pose ``[x, y, theta]`` of the sensor at this scan (m, m, rad), used
+            only through its increment since the previous scan with odometry.
+
+        Returns
+        -------
+        ndarray, shape (3,)
+            Pose ``[x, y, theta]`` of the scan in the map frame.
+
+        Raises
+        ------
+        TypeError, ValueError
+            On a wrong shape or type, lengths that differ, or a non-finite angle or odom;
+            the loop is unchanged after an error.
+        """
+        step = self._loop.step(ranges, angles, odom)
+        self._last = step
+        pose: F64 = step.pose
+        return pose
+
+    @property
+    def last_step(self) -> OdometryStep | None:
+        """What the last :meth:`step` did (prediction, match, insertion), or ``None``."""
+        return self._last
+
+    @property
+    def poses(self) -> F64:
+        """Pose of every scan so far, shape (T, 3)."""
+        poses: F64 = self._loop.poses
+        return poses
+
+    @property
+    def insertions(self) -> int:
+        """Scans added to the map so far."""
+        return int(self._loop.insertions)
+
+    def __len__(self) -> int:
+        """Cells in the map now."""
+        return len(self._loop)
+
+    def grid(self) -> NdtGrid:
+        """A copy of the map the scans are matched against."""
+        grid: NdtGrid = self._loop.grid()
+        return grid
+
+    def __repr__(self) -> str:
+        return (
+            f"Odometry(cell_size={self.cell_size}, scans={self.poses.shape[0]}, "
+            f"insertions={self.insertions}, cells={len(self)})"
+        )

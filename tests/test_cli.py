@@ -1,0 +1,161 @@
+"""The ``ndtgrid`` command line end to end: ``map`` (on a synthetic and real logs), ``eval``."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import ndtgrid
+from ndtgrid.cli import main
+from ndtgrid.export import load_map, read_ros_map, read_tum, write_tum
+from ndtgrid.io import read_benchmark_index
+
+from ._data import require_real
+from ._room import scan as room_scan
+
+N_SCANS = 40
+
+
+def room_path(n: int) -> np.ndarray:
+    t = np.arange(n, dtype=float)
+    return np.stack([-1.5 + 0.06 * t, -0.8 + 0.4 * np.sin(t / 10.0), 0.2 * np.sin(t / 8.0)], 1)
+
+
+def carmen_log(path: Path) -> np.ndarray:
+    """A CARMEN log of the test room (181 beams over 180 degrees); returns the true poses."""
+    poses = room_path(N_SCANS)
+    lines = []
+    for k, p in enumerate(poses):
+        pts = room_scan(p, beams=181, fov_deg=180.0, noise=0.005, seed=k)
+        ranges = np.hypot(pts[:, 0], pts[:, 1])
+        odom = p + np.array([0.0, 0.0, 0.01 * k])  # drifting heading
+        fields = ["FLASER", "181", *(f"{r:.4f}" for r in ranges)]
+        fields += [f"{v:.6f}" for v in (*odom, *odom)]
+        lines.append(" ".join([*fields, f"{10 + 0.1 * k:.3f}", "host", f"{10 + 0.1 * k:.3f}"]))
+    path.write_text("\n".join(lines) + "\n")
+    return poses
+
+
+def test_version_and_help(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as info:
+        main(["--version"])
+    assert info.value.code == 0
+    assert capsys.readouterr().out.strip() == f"ndtgrid {ndtgrid.__version__}"
+    assert main([]) == 0
+    out = capsys.readouterr().out
+    assert "map" in out and "eval" in out
+
+
+def test_map_writes_every_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    truth = carmen_log(tmp_path / "room.log")
+    out = tmp_path / "out"
+    assert main(["map", str(tmp_path / "room.log"), "--out", str(out), "--quiet"]) == 0
+    assert f"{N_SCANS} scans in" in capsys.readouterr().out
+    for name in ("map.png", "map.pgm", "map.yaml", "trajectory.tum", "map.npz"):
+        assert (out / name).stat().st_size > 0, name
+    times, poses = read_tum(out / "trajectory.tum")
+    np.testing.assert_allclose(times, 10 + 0.1 * np.arange(N_SCANS), atol=1e-6)
+    # The odometry's heading drifts by 0.01 rad per scan (0.39 rad at the end); matching
+    # keeps the error to what the first scans put into the map.
+    heading = np.abs(poses[:, 2] - truth[:, 2])
+    assert heading.max() < 0.1 * 0.01 * (N_SCANS - 1)
+    assert heading[-10:].max() < math.radians(1.5)
+    assert np.max(np.hypot(*(poses[:, :2] - truth[:, :2]).T)) < 0.05
+    image = read_ros_map(out / "map.yaml")
+    assert image.resolution == 0.05
+    assert (image.cells == 100).sum() > 300 and (image.cells == 0).sum() > 1000
+    grid = load_map(out / "map.npz")
+    assert grid.cell_size == 0.02 and len(grid) > 500
+    assert (out / "map.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_eval_against_tum_and_index(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    ref = room_path(10)
+    est = ref.copy()
+    est[5:, 0] += 0.1  # one relation off by 10 cm
+    write_tum(tmp_path / "ref.tum", np.arange(10.0), ref)
+    write_tum(tmp_path / "est.tum", np.arange(10.0) + 0.01, est)
+    args = ["eval", "--estimate", str(tmp_path / "est.tum"), "--reference"]
+    assert main([*args, str(tmp_path / "ref.tum"), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["n"] == 9
+    assert summary["translation_max"] == pytest.approx(0.1, abs=1e-6)
+    assert summary["translation_mean"] == pytest.approx(0.1 / 9, abs=1e-6)
+    # Nothing within 1 ms: a clear failure, not a silent empty result.
+    assert main([*args, str(tmp_path / "ref.tum"), "--max-dt", "0.001"]) == 1
+    assert "only 0 reference poses" in capsys.readouterr().err
+
+
+def test_map_and_eval_on_the_intel_split(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    log = require_real("benchmark-scans-split/intel.tar.gz")
+    index = require_real("benchmark-scans-split/intel__intel-corrected__index.csv")
+    out = tmp_path / "intel"
+    assert main(["map", str(log), "--out", str(out), "--max-scans", "1500", "--quiet"]) == 0
+    capsys.readouterr()
+    times, _ = read_tum(out / "trajectory.tum")
+    np.testing.assert_array_equal(times, np.arange(1500.0))  # no time in the split: indices
+    assert (
+        main(
+            ["eval", "--estimate", str(out / "trajectory.tum"), "--reference", str(index), "--json"]
+        )
+        == 0
+    )
+    summary = json.loads(capsys.readouterr().out)
+    rows = read_benchmark_index(index)
+    assert summary["n"] == int((rows.raw_scan < 1500).sum()) - 1  # consecutive relations
+    assert summary["translation_mean"] < 0.05 and summary["rotation_mean"] < 1.5
+
+
+def test_map_on_the_mines_log_with_forced_format(tmp_path: Path) -> None:
+    log = require_real("breezyslam-mines-urg04lx/exp1.dat")
+    out = tmp_path / "mines"
+    assert (
+        main(
+            [
+                "map",
+                str(log),
+                "--out",
+                str(out),
+                "--format",
+                "mines",
+                "--max-scans",
+                "200",
+                "--quiet",
+            ]
+        )
+        == 0
+    )
+    times, _ = read_tum(out / "trajectory.tum")
+    assert times.shape == (200,) and times[0] == pytest.approx(212.387282)
+
+
+def test_readings_beyond_max_range_are_dropped() -> None:
+    from ndtgrid.cli import usable_ranges
+    from ndtgrid.io import Scan
+
+    scan = Scan(0.0, [1.0, 8.0, 9.5, 2.0], [0.0, 0.1, 0.2, 0.3], max_range=8.0)
+    np.testing.assert_array_equal(usable_ranges(scan), [1.0, np.nan, np.nan, 2.0])
+    free = Scan(0.0, [1.0, 9.5], [0.0, 0.1])
+    np.testing.assert_array_equal(usable_ranges(free), [1.0, 9.5])
+
+
+def test_console_script_runs() -> None:
+    res = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "from ndtgrid.cli import main; raise SystemExit(main())",
+            "--version",
+        ],
+        capture_output=True,
+        text=True,
+    )
+    assert res.returncode == 0 and res.stdout.startswith("ndtgrid ")

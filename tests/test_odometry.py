@@ -1,0 +1,153 @@
+"""Tests of ``ndtgrid.Odometry``: tracking, priors, memory bound, config, bad input, real log."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+import ndtgrid
+from ndtgrid import se2
+from ndtgrid._core import default_odometry_config
+from ndtgrid.evaluation import relation_errors
+from ndtgrid.io import read_benchmark_index, read_benchmark_split
+
+from ._room import scan as room_scan
+
+BEAMS = 361
+
+
+def polar(pose: np.ndarray, seed: int = 0, noise: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Ranges and angles of a 240-degree laser at ``pose`` in the test room."""
+    pts = room_scan(pose, beams=BEAMS, noise=noise, seed=seed)
+    return np.hypot(pts[:, 0], pts[:, 1]), np.arctan2(pts[:, 1], pts[:, 0])
+
+
+def trajectory(n: int) -> np.ndarray:
+    """A smooth path through the room: 3 cm and about 1 degree per scan."""
+    t = np.arange(n, dtype=float)
+    return np.stack([-1.0 + 0.03 * t, -0.6 + 0.3 * np.sin(t / 15.0), 0.3 * np.sin(t / 20.0)], 1)
+
+
+def errors(est: np.ndarray, truth: np.ndarray) -> tuple[float, float]:
+    d = np.array([se2.between(t, e) for e, t in zip(est, truth)])
+    return float(np.max(np.hypot(d[:, 0], d[:, 1]))), float(np.max(np.abs(d[:, 2])))
+
+
+def test_config_defaults_are_the_cores() -> None:
+    py = dataclasses.asdict(ndtgrid.OdometryConfig())
+    core = default_odometry_config()
+    assert core.pop("cell_size") == 0.02
+    assert py.keys() == core.keys()
+    for key, value in py.items():
+        assert core[key] == pytest.approx(value), key
+
+
+def test_tracks_a_path_without_odometry() -> None:
+    truth = trajectory(60)
+    odo = ndtgrid.Odometry(cell_size=0.02)
+    for k, pose in enumerate(truth):
+        r, a = polar(pose, seed=k, noise=0.005)
+        odo.step(r, a)
+    assert odo.poses.shape == (60, 3)
+    # The trajectory is expressed in the first scan's frame: compare relative poses.
+    est = np.array([se2.between(odo.poses[0], p) for p in odo.poses])
+    ref = np.array([se2.between(truth[0], p) for p in truth])
+    dt, dr = errors(est, ref)
+    assert dt < 0.02 and dr < math.radians(0.5)
+    assert 10 <= odo.insertions < 60
+
+
+def test_odometry_prior_is_used_and_corrected() -> None:
+    truth = trajectory(40)
+    rng = np.random.default_rng(3)
+    # Odometry whose increments are 10 % too long and 1 degree off per scan.
+    odom = [truth[0]]
+    for a, b in zip(truth[:-1], truth[1:]):
+        inc = se2.between(a, b) * [1.1, 1.1, 1.0] + [0, 0, math.radians(1.0)]
+        odom.append(se2.compose(odom[-1], inc + rng.normal(0, 0.002, 3)))
+    odo = ndtgrid.Odometry()
+    for k, (pose, o) in enumerate(zip(truth, odom)):
+        r, a = polar(pose, seed=k)
+        odo.step(r, a, odom=o)
+        step = odo.last_step
+        assert step is not None and step.accepted == (k > 0)  # the first scan starts the map
+    np.testing.assert_allclose(odo.poses[0], truth[0])  # starts at the first odometry pose
+    dt, dr = errors(odo.poses, truth)
+    raw_dt, raw_dr = errors(np.array(odom), truth)
+    assert dt < 0.02 and dr < math.radians(0.5)
+    assert raw_dt > 0.1 and raw_dr > math.radians(20)
+
+
+def test_map_window_bounds_the_map() -> None:
+    truth = trajectory(80)
+    bounded = ndtgrid.Odometry(config=ndtgrid.OdometryConfig(map_window=5, insert_distance=0.02))
+    unbounded = ndtgrid.Odometry(config=ndtgrid.OdometryConfig(map_window=0, insert_distance=0.02))
+    peak = 0
+    for k, pose in enumerate(truth):
+        r, a = polar(pose, seed=k, noise=0.01)
+        bounded.step(r, a)
+        unbounded.step(r, a)
+        peak = max(peak, len(bounded))
+    assert peak <= 5 * BEAMS
+    assert len(unbounded) > 2 * peak
+    assert unbounded.grid().cell_size == 0.02 and len(unbounded.grid()) == len(unbounded)
+
+
+def test_bad_input_is_rejected_and_leaves_the_loop_unchanged() -> None:
+    odo = ndtgrid.Odometry()
+    r, a = polar(np.zeros(3))
+    odo.step(r, a)
+    cells = len(odo)
+    with pytest.raises(ValueError, match=r"angles: expected \d+ values \(one per range\), got"):
+        odo.step(r, a[1:])
+    with pytest.raises(ValueError, match=r"odom: expected 3 values"):
+        odo.step(r, a, odom=[0.0, 1.0])
+    with pytest.raises(ValueError, match=r"odom: expected finite values, got NaN"):
+        odo.step(r, a, odom=[0.0, np.nan, 0.0])
+    with pytest.raises(TypeError, match=r"ranges"):
+        odo.step("abc", a)
+    assert odo.poses.shape == (1, 3) and len(odo) == cells
+    with pytest.raises(ValueError, match="min_match_ratio"):
+        ndtgrid.Odometry(config=ndtgrid.OdometryConfig(min_match_ratio=2.0))
+    with pytest.raises(ValueError, match="max_range"):
+        ndtgrid.Odometry(config=ndtgrid.OdometryConfig(max_range=-1.0))
+    with pytest.raises(ValueError, match="rotation_step"):
+        ndtgrid.Odometry(config=ndtgrid.OdometryConfig(rotation_step=1e-9))
+    with pytest.raises(ValueError, match="cell_size"):
+        ndtgrid.Odometry(cell_size=0.0)
+    with pytest.raises(TypeError, match="OdometryConfig"):
+        ndtgrid.Odometry(config={"max_range": 3.0})  # type: ignore[arg-type]
+
+
+def test_empty_scans_follow_the_prior() -> None:
+    odo = ndtgrid.Odometry()
+    angles = np.linspace(-1, 1, 5)
+    for x in (0.0, 0.1, 0.3):
+        odo.step(np.zeros(5), angles, odom=[x, 0.0, 0.0])
+    np.testing.assert_allclose(odo.poses[:, 0], [0.0, 0.1, 0.3])
+    assert odo.insertions == 0 and len(odo) == 0
+    assert "Odometry(cell_size=0.02, scans=3" in repr(odo)
+
+
+def test_intel_start_beats_raw_odometry() -> None:
+    # The first 2000 raw scans of Intel with raw odometry: relation error on the corrected
+    # scans they contain, against the raw odometry's (full-log numbers in BENCHMARK.md).
+    from ._data import require_real
+
+    scans = list(read_benchmark_split(require_real("benchmark-scans-split/intel.tar.gz")))[:2000]
+    index = read_benchmark_index(
+        require_real("benchmark-scans-split/intel__intel-corrected__index.csv")
+    )
+    odo = ndtgrid.Odometry()
+    for s in scans:
+        odo.step(s.ranges, s.angles, s.odom)
+    keep = index.raw_scan < len(scans)
+    ours = relation_errors(odo.poses[index.raw_scan[keep]], index.corrected[keep]).summary()
+    raw = np.array([s.odom for s in scans])[index.raw_scan[keep]]
+    odom = relation_errors(raw, index.corrected[keep]).summary()
+    assert ours.n == 111
+    assert ours.translation_mean < 0.75 * odom.translation_mean
+    assert ours.rotation_mean < 0.3 * odom.rotation_mean
