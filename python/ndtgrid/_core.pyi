@@ -760,6 +760,9 @@ class OdometryLoop:
         max_iterations: int | None = None,
         max_step_cells: float | None = None,
         max_step_rotation: float | None = None,
+        levels: int | None = None,
+        coarse_rotation_search: float | None = None,
+        freeze_unconstrained: bool | None = None,
     ) -> None: ...
     def step(
         self, ranges: ArrayLike, angles: ArrayLike, odom: ArrayLike | None = None

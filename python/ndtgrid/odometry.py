@@ -69,7 +69,7 @@ class OdometryConfig:
         §IV-A(1) neighbour search.
     fuse_minority : bool, default True
         §IV-A(3) fusion of cells with fewer than 3 points.
-    search_radius : int, default 3
+    search_radius : int, default 1
         Neighbour-search radius [cells].
     max_iterations : int, default 50
         Newton steps per scan at most.
@@ -77,6 +77,15 @@ class OdometryConfig:
         Largest translation per Newton step [cells].
     max_step_rotation : float, default 0.05
         Largest rotation per Newton step [rad].
+    levels : int, optional
+        Pyramid levels the matcher runs coarse to fine (see ``NdtGrid.match``); by
+        default as many as keep the coarsest cell at most 0.64 m.
+    coarse_rotation_search : float, default 0.15
+        The matcher's rotational multi-start on its coarsest level [rad]
+        (``NdtGrid.match(rotation_search=...)``); 0 turns it off.
+    freeze_unconstrained : bool, default True
+        Keep the prediction along directions the scan does not constrain (a
+        corridor's axis) instead of letting fine cells drag the pose.
     """
 
     min_range: float = 0.0
@@ -92,10 +101,13 @@ class OdometryConfig:
     expansion: float = 30.0
     neighbor_search: bool = True
     fuse_minority: bool = True
-    search_radius: int = 3
+    search_radius: int = 1
     max_iterations: int = 50
     max_step_cells: float = 2.0
     max_step_rotation: float = 0.05
+    levels: int | None = None
+    coarse_rotation_search: float = 0.15
+    freeze_unconstrained: bool = True
 
 
 class Odometry:

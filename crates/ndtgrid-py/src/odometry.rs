@@ -101,7 +101,8 @@ impl PyOdometry {
         rotation_step = None, prior_gap_distance = None, prior_gap_angle = None,
         expansion = None,
         neighbor_search = None, fuse_minority = None, search_radius = None,
-        max_iterations = None, max_step_cells = None, max_step_rotation = None
+        max_iterations = None, max_step_cells = None, max_step_rotation = None,
+        levels = None, coarse_rotation_search = None, freeze_unconstrained = None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -116,7 +117,6 @@ impl PyOdometry {
         rotation_step: Option<f64>,
         prior_gap_distance: Option<f64>,
         prior_gap_angle: Option<f64>,
-
         expansion: Option<f64>,
         neighbor_search: Option<bool>,
         fuse_minority: Option<bool>,
@@ -124,6 +124,9 @@ impl PyOdometry {
         max_iterations: Option<i64>,
         max_step_cells: Option<f64>,
         max_step_rotation: Option<f64>,
+        levels: Option<i64>,
+        coarse_rotation_search: Option<f64>,
+        freeze_unconstrained: Option<bool>,
     ) -> PyResult<Self> {
         let d = OdometryConfig::default();
         let m = d.matcher;
@@ -145,6 +148,12 @@ impl PyOdometry {
                 .unwrap_or(m.max_iterations),
             max_step_cells: max_step_cells.unwrap_or(m.max_step_cells),
             max_step_rotation: max_step_rotation.unwrap_or(m.max_step_rotation),
+            levels: match levels {
+                Some(l) => Some(count("levels", l)?),
+                None => m.levels,
+            },
+            rotation_search: coarse_rotation_search.unwrap_or(m.rotation_search),
+            freeze_unconstrained: freeze_unconstrained.unwrap_or(m.freeze_unconstrained),
             ..m
         };
         let config = OdometryConfig {
@@ -159,7 +168,6 @@ impl PyOdometry {
             rotation_step: rotation_step.unwrap_or(d.rotation_step),
             prior_gap_distance: prior_gap_distance.unwrap_or(d.prior_gap_distance),
             prior_gap_angle: prior_gap_angle.unwrap_or(d.prior_gap_angle),
-
             matcher,
         };
         Ok(Self {
@@ -239,7 +247,6 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("rotation_step", c.rotation_step)?;
     out.set_item("prior_gap_distance", c.prior_gap_distance)?;
     out.set_item("prior_gap_angle", c.prior_gap_angle)?;
-
     out.set_item("expansion", c.matcher.expansion)?;
     out.set_item("neighbor_search", c.matcher.neighbor_search)?;
     out.set_item("fuse_minority", c.matcher.fuse_minority)?;
@@ -247,6 +254,9 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("max_iterations", c.matcher.max_iterations)?;
     out.set_item("max_step_cells", c.matcher.max_step_cells)?;
     out.set_item("max_step_rotation", c.matcher.max_step_rotation)?;
+    out.set_item("levels", c.matcher.levels)?;
+    out.set_item("coarse_rotation_search", c.matcher.rotation_search)?;
+    out.set_item("freeze_unconstrained", c.matcher.freeze_unconstrained)?;
     Ok(out)
 }
 
