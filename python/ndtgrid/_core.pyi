@@ -763,6 +763,11 @@ class OdometryLoop:
         levels: int | None = None,
         coarse_rotation_search: float | None = None,
         freeze_unconstrained: bool | None = None,
+        outlier_filter: bool | None = None,
+        edge_removal: bool | None = None,
+        backshift_rejection: bool | None = None,
+        observation_check: bool | None = None,
+        radial_confirmation: bool | None = None,
     ) -> None: ...
     def step(
         self, ranges: ArrayLike, angles: ArrayLike, odom: ArrayLike | None = None
@@ -785,6 +790,8 @@ class OdometryLoop:
         """Cells in the map now."""
     def grid(self) -> NdtGrid:
         """A copy of the map."""
+    def mapper(self) -> Mapper:
+        """A copy of the mapper (grid and §V filter state)."""
     def config(self) -> dict[str, Any]:
         """The settings in force, as keyword arguments (plus ``cell_size``)."""
 

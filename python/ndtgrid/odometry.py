@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from ndtgrid._core import NdtGrid, OdometryLoop, OdometryStep
+from ndtgrid._core import Mapper, NdtGrid, OdometryLoop, OdometryStep
 
 __all__ = ["Odometry", "OdometryConfig", "OdometryStep"]
 
@@ -86,6 +86,16 @@ class OdometryConfig:
     freeze_unconstrained : bool, default True
         Keep the prediction along directions the scan does not constrain (a
         corridor's axis) instead of letting fine cells drag the pose.
+    outlier_filter : bool, default True
+        Insert scans through the paper's §V elimination (sub-grid objects, wall
+        speckle, moved objects) with :class:`~ndtgrid.MapperOptions`' defaults;
+        ``False`` inserts every valid point.
+    edge_removal, backshift_rejection, observation_check, radial_confirmation : bool
+        The §V steps a, b, c, d (see :class:`~ndtgrid.MapperOptions`). Step b is off
+        by default here: it trusts Area 2 (beyond a URG-04LX's 0.5 m reliable range)
+        only where Area 1 confirms it, and with a SICK in a large building nearly
+        everything is Area 2 (first 2000 Intel scans: 0.0448 m relation error with
+        it, 0.0327 m without, 0.0330 m with no elimination).
     """
 
     min_range: float = 0.0
@@ -108,6 +118,11 @@ class OdometryConfig:
     levels: int | None = None
     coarse_rotation_search: float = 0.15
     freeze_unconstrained: bool = True
+    outlier_filter: bool = True
+    edge_removal: bool = True
+    backshift_rejection: bool = False
+    observation_check: bool = True
+    radial_confirmation: bool = True
 
 
 class Odometry:
@@ -225,6 +240,16 @@ class Odometry:
         """A copy of the map the scans are matched against."""
         grid: NdtGrid = self._loop.grid()
         return grid
+
+    @property
+    def mapper(self) -> Mapper:
+        """The :class:`~ndtgrid.Mapper` the loop builds (its grid and §V filter state).
+
+        A copy as of this access: later steps do not change it, and changing it does
+        not change the loop.
+        """
+        mapper: Mapper = self._loop.mapper()
+        return mapper
 
     def __repr__(self) -> str:
         return (

@@ -57,6 +57,22 @@ impl PyMapper {
     }
 }
 
+impl PyMapper {
+    /// A Python mapper holding `mapper` (a copy handed out by another object).
+    pub(crate) fn from_core(py: Python<'_>, mapper: ndt_core::Mapper) -> PyResult<Self> {
+        let options = Py::new(py, PyMapperOptions::from(*mapper.filter().options()))?;
+        let (grid, filter) = mapper.into_parts();
+        let grid = Arc::new(RwLock::new(grid));
+        let grid_handle = Py::new(py, PyNdtGrid::shared(Arc::clone(&grid)))?;
+        Ok(Self {
+            grid,
+            filter: Mutex::new(filter),
+            grid_handle,
+            options,
+        })
+    }
+}
+
 #[pymethods]
 impl PyMapper {
     #[new]

@@ -102,7 +102,9 @@ impl PyOdometry {
         expansion = None,
         neighbor_search = None, fuse_minority = None, search_radius = None,
         max_iterations = None, max_step_cells = None, max_step_rotation = None,
-        levels = None, coarse_rotation_search = None, freeze_unconstrained = None
+        levels = None, coarse_rotation_search = None, freeze_unconstrained = None,
+        outlier_filter = None, edge_removal = None, backshift_rejection = None,
+        observation_check = None, radial_confirmation = None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -127,6 +129,11 @@ impl PyOdometry {
         levels: Option<i64>,
         coarse_rotation_search: Option<f64>,
         freeze_unconstrained: Option<bool>,
+        outlier_filter: Option<bool>,
+        edge_removal: Option<bool>,
+        backshift_rejection: Option<bool>,
+        observation_check: Option<bool>,
+        radial_confirmation: Option<bool>,
     ) -> PyResult<Self> {
         let d = OdometryConfig::default();
         let m = d.matcher;
@@ -169,6 +176,14 @@ impl PyOdometry {
             prior_gap_distance: prior_gap_distance.unwrap_or(d.prior_gap_distance),
             prior_gap_angle: prior_gap_angle.unwrap_or(d.prior_gap_angle),
             matcher,
+            mapper: ndt_core::MapperOptions {
+                outlier_filter: outlier_filter.unwrap_or(d.mapper.outlier_filter),
+                edge_removal: edge_removal.unwrap_or(d.mapper.edge_removal),
+                backshift_rejection: backshift_rejection.unwrap_or(d.mapper.backshift_rejection),
+                observation_check: observation_check.unwrap_or(d.mapper.observation_check),
+                radial_confirmation: radial_confirmation.unwrap_or(d.mapper.radial_confirmation),
+                ..d.mapper
+            },
         };
         Ok(Self {
             inner: Mutex::new(Odometry::new(config).map_err(to_py)?),
@@ -227,6 +242,12 @@ impl PyOdometry {
         Ok(PyNdtGrid::from(grid))
     }
 
+    /// A copy of the mapper (grid and §V filter state) as of this call.
+    fn mapper(&self, py: Python<'_>) -> PyResult<crate::mapper::PyMapper> {
+        let mapper = py.detach(|| self.lock().map(|o| o.mapper().clone()))?;
+        crate::mapper::PyMapper::from_core(py, mapper)
+    }
+
     /// The settings in force, as keyword arguments of the constructor.
     fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let c = *self.lock()?.config();
@@ -257,6 +278,11 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("levels", c.matcher.levels)?;
     out.set_item("coarse_rotation_search", c.matcher.rotation_search)?;
     out.set_item("freeze_unconstrained", c.matcher.freeze_unconstrained)?;
+    out.set_item("outlier_filter", c.mapper.outlier_filter)?;
+    out.set_item("edge_removal", c.mapper.edge_removal)?;
+    out.set_item("backshift_rejection", c.mapper.backshift_rejection)?;
+    out.set_item("observation_check", c.mapper.observation_check)?;
+    out.set_item("radial_confirmation", c.mapper.radial_confirmation)?;
     Ok(out)
 }
 

@@ -155,6 +155,11 @@ impl Mapper {
         &self.grid
     }
 
+    /// The grid and the filter state, taken apart.
+    pub fn into_parts(self) -> (NdtGrid, MapFilter) {
+        (self.grid, self.filter)
+    }
+
     /// The filter state.
     pub fn filter(&self) -> &MapFilter {
         &self.filter
@@ -175,6 +180,12 @@ impl Mapper {
     /// What each step removed so far.
     pub fn removal_counts(&self) -> RemovalCounts {
         self.filter.removal_counts()
+    }
+
+    /// Removes the cells `keys` from the map (see [`NdtGrid::remove_cells`]);
+    /// their filter records go with the next periodic check.
+    pub fn remove_cells(&mut self, keys: &[CellKey]) -> usize {
+        self.grid.remove_cells(keys)
     }
 
     /// Runs the periodic checks now (see [`MapFilter::run_checks`]).
