@@ -31,3 +31,21 @@ def test_version_from_the_command_line() -> None:
         [sys.executable, "-m", "ndtgrid", "--version"], capture_output=True, text=True, check=True
     ).stdout
     assert out.strip() == f"ndtgrid {ndtgrid.__version__}"
+
+
+def test_demo_maps_the_simulated_room(tmp_path: Path, capsys: object) -> None:
+    from ndtgrid.cli import main
+
+    assert main(["demo", "--out", str(tmp_path), "--quiet"]) == 0
+    out = capsys.readouterr().out  # type: ignore[attr-defined]
+    for name in ("map.png", "map.pgm", "map.yaml", "trajectory.tum", "map.npz"):
+        assert (tmp_path / name).stat().st_size > 0, name
+    m = re.search(
+        r"pose error against the truth: (\S+) cm RMS, (\S+) cm max "
+        r"\(odometry alone: (\S+) cm max\); (\d+) small objects",
+        out,
+    )
+    assert m is not None, out
+    rms, worst, odometry = (float(m.group(i)) for i in (1, 2, 3))
+    assert rms < 1.0 and worst < 2.0 and worst < odometry / 3
+    assert int(m.group(4)) >= 8
