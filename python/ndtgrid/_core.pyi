@@ -768,6 +768,7 @@ class OdometryLoop:
         backshift_rejection: bool | None = None,
         observation_check: bool | None = None,
         radial_confirmation: bool | None = None,
+        match_filtered_map: bool | None = None,
     ) -> None: ...
     def step(
         self, ranges: ArrayLike, angles: ArrayLike, odom: ArrayLike | None = None

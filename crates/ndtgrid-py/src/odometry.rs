@@ -104,7 +104,7 @@ impl PyOdometry {
         max_iterations = None, max_step_cells = None, max_step_rotation = None,
         levels = None, coarse_rotation_search = None, freeze_unconstrained = None,
         outlier_filter = None, edge_removal = None, backshift_rejection = None,
-        observation_check = None, radial_confirmation = None
+        observation_check = None, radial_confirmation = None, match_filtered_map = None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -134,6 +134,7 @@ impl PyOdometry {
         backshift_rejection: Option<bool>,
         observation_check: Option<bool>,
         radial_confirmation: Option<bool>,
+        match_filtered_map: Option<bool>,
     ) -> PyResult<Self> {
         let d = OdometryConfig::default();
         let m = d.matcher;
@@ -184,6 +185,7 @@ impl PyOdometry {
                 radial_confirmation: radial_confirmation.unwrap_or(d.mapper.radial_confirmation),
                 ..d.mapper
             },
+            match_filtered_map: match_filtered_map.unwrap_or(d.match_filtered_map),
         };
         Ok(Self {
             inner: Mutex::new(Odometry::new(config).map_err(to_py)?),
@@ -283,6 +285,7 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("backshift_rejection", c.mapper.backshift_rejection)?;
     out.set_item("observation_check", c.mapper.observation_check)?;
     out.set_item("radial_confirmation", c.mapper.radial_confirmation)?;
+    out.set_item("match_filtered_map", c.match_filtered_map)?;
     Ok(out)
 }
 
