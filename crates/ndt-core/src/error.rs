@@ -101,6 +101,27 @@ impl std::fmt::Display for Num {
 /// Result alias of the core.
 pub type Result<T> = std::result::Result<T, NdtError>;
 
+/// Fails with [`NdtError::InvalidOption`] unless `value` is finite and at
+/// least `min` (strictly more when `strict`); `expected` says so in words.
+pub(crate) fn check_bound(
+    name: &'static str,
+    expected: &'static str,
+    value: f64,
+    min: f64,
+    strict: bool,
+) -> Result<()> {
+    let ok = value.is_finite() && if strict { value > min } else { value >= min };
+    if ok {
+        Ok(())
+    } else {
+        Err(NdtError::InvalidOption {
+            name,
+            expected,
+            value,
+        })
+    }
+}
+
 /// Fails with [`NdtError::NonFinite`] on the first non-finite value.
 pub(crate) fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {
     match values.iter().position(|v| !v.is_finite()) {

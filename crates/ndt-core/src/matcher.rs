@@ -7,7 +7,7 @@ use nalgebra::{Matrix3, Vector2};
 use crate::cell::Gaussian;
 use crate::degeneracy::{constrained_projector, unconstrained_directions};
 use crate::distributions::{DistOptions, Distributions};
-use crate::error::{check_finite, NdtError, Result};
+use crate::error::{check_bound, check_finite, NdtError, Result};
 use crate::grid::{check_points, NdtGrid};
 use crate::information::{own_cell_pairs, point_to_plane_information};
 use crate::key::CellKey;
@@ -115,15 +115,7 @@ impl MatchOptions {
     /// Checks every option's range.
     pub fn validate(&self) -> Result<()> {
         let positive = |name: &'static str, value: f64| {
-            if value.is_finite() && value > 0.0 {
-                Ok(())
-            } else {
-                Err(NdtError::InvalidOption {
-                    name,
-                    expected: "a finite value > 0",
-                    value,
-                })
-            }
+            check_bound(name, "a finite value > 0", value, 0.0, true)
         };
         positive("expansion", self.expansion)?;
         positive("translation_tolerance", self.translation_tolerance)?;

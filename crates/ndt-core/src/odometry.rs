@@ -19,7 +19,7 @@ use std::collections::VecDeque;
 
 use rustc_hash::FxHashMap;
 
-use crate::error::{check_finite, NdtError, Result};
+use crate::error::{check_bound, check_finite, NdtError, Result};
 use crate::grid::NdtGrid;
 use crate::key::CellKey;
 use crate::mapper::{Mapper, MapperOptions};
@@ -121,15 +121,7 @@ impl OdometryConfig {
     /// Checks every setting's range.
     pub fn validate(&self) -> Result<()> {
         let non_negative = |name: &'static str, value: f64| {
-            if value.is_finite() && value >= 0.0 {
-                Ok(())
-            } else {
-                Err(NdtError::InvalidOption {
-                    name,
-                    expected: "a finite value >= 0",
-                    value,
-                })
-            }
+            check_bound(name, "a finite value >= 0", value, 0.0, false)
         };
         non_negative("insert_distance", self.insert_distance)?;
         non_negative("insert_angle", self.insert_angle)?;

@@ -1,7 +1,7 @@
 //! The options of the §V elimination: a switch per step and the step's
 //! parameters, with the paper's values as defaults where it gives them.
 
-use crate::error::{NdtError, Result};
+use crate::error::{check_bound, NdtError, Result};
 
 /// Options of [`crate::Mapper`] / [`crate::MapFilter`]. Lengths in metres.
 ///
@@ -113,15 +113,7 @@ impl MapperOptions {
     /// Checks every option's range.
     pub fn validate(&self) -> Result<()> {
         let non_negative = |name: &'static str, value: f64| {
-            if value.is_finite() && value >= 0.0 {
-                Ok(())
-            } else {
-                Err(NdtError::InvalidOption {
-                    name,
-                    expected: "a finite length >= 0 m",
-                    value,
-                })
-            }
+            check_bound(name, "a finite length >= 0 m", value, 0.0, false)
         };
         non_negative("min_range", self.min_range)?;
         non_negative("reliable_range", self.reliable_range)?;
