@@ -32,6 +32,7 @@ import peers as peer_lib
 import ndtgrid
 from ndtgrid.evaluation import corrected_pairs, pose_error
 from ndtgrid.io import read_benchmark_index, read_carmen
+from ndtgrid.presets import ORIGINAL_NDT, PAPER
 
 REAL = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real"
 LOGS = {
@@ -41,13 +42,6 @@ LOGS = {
     "MIT CSAIL": ("csail-corrected.log.gz", "mit_csail__csail-corrected__index.csv"),
 }
 MAX_RANGE = 40.0
-PAPER = {
-    "levels": 1,
-    "rotation_search": 0.0,
-    "freeze_unconstrained": False,
-    "search_radius": 3,
-}
-ORIGINAL = {**PAPER, "expansion": 1.0, "neighbor_search": False, "fuse_minority": False}
 
 
 @dataclass
@@ -119,11 +113,11 @@ def ours(name: str, cell: float, **options: Any) -> peer_lib.Peer:
 def methods() -> list[peer_lib.Peer]:
     """Our settings and the peers."""
     out = [
-        ours("NDT 2 cm original (k=1)", 0.02, **ORIGINAL),
-        ours("NDT 20 cm original (k=1)", 0.2, **ORIGINAL),
-        ours("2 cm + expansion k=10 only", 0.02, **{**ORIGINAL, "expansion": 10.0}),
-        ours("2 cm + neighbour search only", 0.02, **{**ORIGINAL, "neighbor_search": True}),
-        ours("2 cm + fusion only", 0.02, **{**ORIGINAL, "fuse_minority": True}),
+        ours("NDT 2 cm original (k=1)", 0.02, **ORIGINAL_NDT),
+        ours("NDT 20 cm original (k=1)", 0.2, **ORIGINAL_NDT),
+        ours("2 cm + expansion k=10 only", 0.02, **{**ORIGINAL_NDT, "expansion": 10.0}),
+        ours("2 cm + neighbour search only", 0.02, **{**ORIGINAL_NDT, "neighbor_search": True}),
+        ours("2 cm + fusion only", 0.02, **{**ORIGINAL_NDT, "fuse_minority": True}),
         ours("2 cm paper (all three fixes)", 0.02, **PAPER),
         ours(
             "2 cm paper, phased k = 100, 10, 1", 0.02, **PAPER, expansion_phases=[100.0, 10.0, 1.0]

@@ -25,17 +25,18 @@ import numpy as np
 import ndtgrid
 from ndtgrid.evaluation import corrected_pairs, pose_error
 from ndtgrid.io import read_benchmark_index, read_carmen
+from ndtgrid.presets import PAPER
 
 REAL = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real"
-ORIGINAL = {
+EVAL_ORIGINAL = {  # evaluate() takes only the scoring options
     "expansion": 1.0,
     "neighbor_search": False,
     "fuse_minority": False,
     "pair_neighbors": False,
 }
 PANELS = [
-    ("(b) original NDT, 2 cm", 0.02, ORIGINAL),
-    ("(c) original NDT, 20 cm", 0.2, ORIGINAL),
+    ("(b) original NDT, 2 cm", 0.02, EVAL_ORIGINAL),
+    ("(c) original NDT, 20 cm", 0.2, EVAL_ORIGINAL),
     (
         "(d) 2 cm, k = 10",
         0.02,
@@ -45,10 +46,7 @@ PANELS = [
     ("(f) 2 cm, k = 100 + fusion", 0.02, {"expansion": 100.0, "pair_neighbors": False}),
 ]
 MAPS = [
-    (
-        "paper's method (k = 10, 2 cm)",
-        {"levels": 1, "rotation_search": 0.0, "freeze_unconstrained": False, "search_radius": 3},
-    ),
+    ("paper's method (k = 10, 2 cm)", PAPER),
     ("default match()", {}),
 ]
 

@@ -18,25 +18,19 @@ import numpy as np
 import ndtgrid
 from ndtgrid.evaluation import corrected_pairs, pose_error
 from ndtgrid.io import read_benchmark_index, read_carmen
+from ndtgrid.presets import ORIGINAL_NDT, PAPER
 
 REAL = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real"
 
-PAPER = {
-    "levels": 1,
-    "rotation_search": 0.0,
-    "freeze_unconstrained": False,
-    "search_radius": 3,
-}
-ORIGINAL = {**PAPER, "expansion": 1.0, "neighbor_search": False, "fuse_minority": False}
 SETTINGS = {
     "2 cm, default match() (2–64 cm pyramid, rotation multi-start, frozen degenerate directions)": (
         0.02,
         {},
     ),
     "2 cm, paper (k=10, neighbours, fusion)": (0.02, PAPER),
-    "2 cm, original NDT (k=1)": (0.02, ORIGINAL),
+    "2 cm, original NDT (k=1)": (0.02, ORIGINAL_NDT),
     "20 cm, paper": (0.2, PAPER),
-    "20 cm, original NDT (k=1)": (0.2, ORIGINAL),
+    "20 cm, original NDT (k=1)": (0.2, ORIGINAL_NDT),
 }
 
 

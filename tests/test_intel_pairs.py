@@ -15,6 +15,7 @@ import pytest
 import ndtgrid
 from ndtgrid.evaluation import corrected_pairs, pose_error
 from ndtgrid.io import read_benchmark_index, read_carmen
+from ndtgrid.presets import PAPER
 
 from ._data import require_real
 
@@ -31,14 +32,6 @@ def pairs() -> list[ndtgrid.evaluation.ScanPair]:
     scans = list(read_carmen(log))
     out = list(corrected_pairs(scans, index, max_range=MAX_RANGE))
     return out[:N_PAIRS]
-
-
-PAPER = {
-    "levels": 1,
-    "rotation_search": 0.0,
-    "freeze_unconstrained": False,
-    "search_radius": 3,
-}
 
 
 def errors(

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from ndtgrid import (
     io,
+    presets,
     se2,
     sim,
 )
@@ -51,6 +52,7 @@ __all__ = [
     "default_mapper_options",
     "default_match_options",
     "io",
+    "presets",
     "ranges_to_points",
     "se2",
     "sim",

@@ -1,0 +1,34 @@
+"""Keyword presets of :meth:`ndtgrid.NdtGrid.match` for the methods the defaults grew from.
+
+Examples
+--------
+>>> import ndtgrid
+>>> from ndtgrid.presets import ORIGINAL_NDT, PAPER
+>>> grid = ndtgrid.NdtGrid(0.02)
+>>> sorted(PAPER)
+['freeze_unconstrained', 'levels', 'rotation_search', 'search_radius']
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = ["ORIGINAL_NDT", "PAPER"]
+
+#: Takubo et al. (IROS 2009) alone: the fine grid only, k = 10, neighbour search (3 cells)
+#: and minority fusion, no pyramid, no rotational multi-start, no frozen directions.
+PAPER: dict[str, Any] = {
+    "levels": 1,
+    "rotation_search": 0.0,
+    "freeze_unconstrained": False,
+    "search_radius": 3,
+}
+
+#: Biber & Strasser's original NDT on the same grid: additionally k = 1, no neighbour
+#: search, no fusion.
+ORIGINAL_NDT: dict[str, Any] = {
+    **PAPER,
+    "expansion": 1.0,
+    "neighbor_search": False,
+    "fuse_minority": False,
+}
