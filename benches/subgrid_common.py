@@ -122,14 +122,5 @@ def build(
 
 
 STICK_NAMES = ["W1", "W2", "W3", "W4", "W5", "W6", "I1", "I2"]
-COUNT_KEYS = [
-    "behind_com_points",
-    "behind_com_cells",
-    "forefront_points",
-    "forefront_cells",
-    "area1_cells",
-    "backshift_points",
-    "backshift_cells",
-    "observation_cells",
-    "confirmation_cells",
-]
+# The per-step counters, in the order the core reports them.
+COUNT_KEYS = list(ndtgrid.Mapper().removal_counts().as_dict())

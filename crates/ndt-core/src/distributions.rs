@@ -52,7 +52,7 @@ impl Distributions {
     }
 
     /// Recomputes the cells whose distribution may have changed after the
-    /// cells `touched` received points: those cells, and with fusion their 8
+    /// cells `touched` gained or lost points: those cells, and with fusion their 8
     /// neighbours (whose fused sums include them).
     pub fn update(
         &mut self,

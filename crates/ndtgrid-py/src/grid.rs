@@ -8,7 +8,7 @@
 use std::sync::{Arc, RwLock};
 
 use ndt_core::{MatchOptions, NdtGrid, Pose2};
-use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -239,38 +239,12 @@ impl PyNdtGrid {
 
     /// The eq. (6) sums of every cell in map coordinates: `(K, 2)` int64 cell
     /// indices, `(K,)` counts `M`, `(K, 2)` sums `m`, `(K, 2, 2)` sums `S`.
-    #[allow(clippy::type_complexity)]
-    fn cell_statistics<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(
-        Bound<'py, PyArray2<i64>>,
-        Bound<'py, PyArray1<i64>>,
-        Bound<'py, PyArray2<f64>>,
-        Bound<'py, PyArray3<f64>>,
-    )> {
-        let (keys, counts, sums, scatters) = self.read(py, |g| {
+    fn cell_statistics<'py>(&self, py: Python<'py>) -> PyResult<crate::state::StateArrays<'py>> {
+        let flat = self.read(py, |g| {
             let recs = g.cells();
-            let mut keys = Vec::with_capacity(recs.len() * 2);
-            let mut counts = Vec::with_capacity(recs.len());
-            let mut sums = Vec::with_capacity(recs.len() * 2);
-            let mut scatters = Vec::with_capacity(recs.len() * 4);
-            for r in &recs {
-                keys.extend_from_slice(&[i64::from(r.key.ix), i64::from(r.key.iy)]);
-                counts.push(i64::try_from(r.count).unwrap_or(i64::MAX));
-                sums.extend_from_slice(&[r.sum.x, r.sum.y]);
-                let s = &r.scatter;
-                scatters.extend_from_slice(&[s[(0, 0)], s[(0, 1)], s[(1, 0)], s[(1, 1)]]);
-            }
-            (keys, counts, sums, scatters)
+            crate::state::flatten_rows(recs.iter().map(|r| (r.key, r.count, &r.sum, &r.scatter)))
         })?;
-        let k = counts.len();
-        Ok((
-            PyArray1::from_vec(py, keys).reshape([k, 2])?,
-            PyArray1::from_vec(py, counts),
-            PyArray1::from_vec(py, sums).reshape([k, 2])?,
-            PyArray1::from_vec(py, scatters).reshape([k, 2, 2])?,
-        ))
+        crate::state::to_arrays(py, flat)
     }
 
     /// The exact cell state (sums about each cell's centre), sorted by index.

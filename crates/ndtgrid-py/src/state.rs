@@ -20,20 +20,30 @@ pub type StateArrays<'py> = (
 /// Flat copies of the cell states: keys, counts, sums, scatters (row-major).
 pub type StateVecs = (Vec<i64>, Vec<i64>, Vec<f64>, Vec<f64>);
 
-/// Flattens the grid's cell states (sums about each cell's centre).
-pub fn flatten(grid: &NdtGrid) -> StateVecs {
-    let states = grid.cell_states();
-    let k = states.len();
+/// Flattens `(key, count, sum, scatter)` rows, in the order given.
+pub fn flatten_rows<'a>(
+    rows: impl ExactSizeIterator<Item = (CellKey, u64, &'a Vector2<f64>, &'a Matrix2<f64>)>,
+) -> StateVecs {
+    let k = rows.len();
     let (mut keys, mut counts) = (Vec::with_capacity(2 * k), Vec::with_capacity(k));
     let (mut sums, mut scatters) = (Vec::with_capacity(2 * k), Vec::with_capacity(4 * k));
-    for (key, s) in &states {
+    for (key, count, sum, m) in rows {
         keys.extend_from_slice(&[i64::from(key.ix), i64::from(key.iy)]);
-        counts.push(i64::try_from(s.count).unwrap_or(i64::MAX));
-        sums.extend_from_slice(&[s.sum.x, s.sum.y]);
-        let m = &s.scatter;
+        counts.push(i64::try_from(count).unwrap_or(i64::MAX));
+        sums.extend_from_slice(&[sum.x, sum.y]);
         scatters.extend_from_slice(&[m[(0, 0)], m[(0, 1)], m[(1, 0)], m[(1, 1)]]);
     }
     (keys, counts, sums, scatters)
+}
+
+/// Flattens the grid's cell states (sums about each cell's centre).
+pub fn flatten(grid: &NdtGrid) -> StateVecs {
+    let states = grid.cell_states();
+    flatten_rows(
+        states
+            .iter()
+            .map(|(k, s)| (*k, s.count, &s.sum, &s.scatter)),
+    )
 }
 
 /// The flattened states as numpy arrays.

@@ -34,13 +34,9 @@ impl Area {
 /// [`crate::filter::observation::CellInfo::is_small`]) that were never
 /// observed from Area 1. Sorted, so results are deterministic.
 pub fn unconfirmed_small(table: &CellTable) -> Vec<CellKey> {
-    let mut out: Vec<CellKey> = table
-        .iter()
-        .filter(|(_, c)| c.is_small() && !c.seen_in_area1)
-        .map(|(&k, _)| k)
-        .collect();
-    out.sort_unstable();
-    out
+    super::sorted_keys(table.iter().map(|(&k, c)| (k, c)), |_, c| {
+        c.is_small() && !c.seen_in_area1
+    })
 }
 
 #[cfg(test)]

@@ -142,13 +142,7 @@ pub fn cells_to_clear(passes: &[Pass]) -> Vec<CellKey> {
             e.2 = true;
         }
     }
-    let mut out: Vec<CellKey> = sides
-        .into_iter()
-        .filter(|(_, (small, left, right))| !small || (*left && *right))
-        .map(|(k, _)| k)
-        .collect();
-    out.sort_unstable();
-    out
+    super::sorted_keys(sides, |_, (small, left, right)| !small || (*left && *right))
 }
 
 #[cfg(test)]

@@ -53,3 +53,18 @@ impl Beam {
         }
     }
 }
+
+/// The keys of the entries of `cells` that pass `keep`, sorted (the steps
+/// report the cells they delete in key order, so runs are deterministic).
+pub(crate) fn sorted_keys<V>(
+    cells: impl IntoIterator<Item = (crate::key::CellKey, V)>,
+    mut keep: impl FnMut(crate::key::CellKey, &V) -> bool,
+) -> Vec<crate::key::CellKey> {
+    let mut out: Vec<crate::key::CellKey> = cells
+        .into_iter()
+        .filter(|(k, v)| keep(*k, v))
+        .map(|(k, _)| k)
+        .collect();
+    out.sort_unstable();
+    out
+}

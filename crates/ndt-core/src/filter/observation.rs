@@ -104,17 +104,11 @@ pub fn rarely_seen(
     let supported = |k: CellKey| {
         (-1..=1).any(|dy| (-1..=1).any(|dx| (dx, dy) != (0, 0) && established(k.offset(dx, dy))))
     };
-    let mut out: Vec<CellKey> = table
-        .iter()
-        .filter(|(&k, c)| {
-            scan + 1 >= c.first_seen + u64::from(interval)
-                && c.observations < min_observations
-                && !(support && supported(k))
-        })
-        .map(|(&k, _)| k)
-        .collect();
-    out.sort_unstable();
-    out
+    super::sorted_keys(table.iter().map(|(&k, c)| (k, c)), |k, c| {
+        scan + 1 >= c.first_seen + u64::from(interval)
+            && c.observations < min_observations
+            && !(support && supported(k))
+    })
 }
 
 #[cfg(test)]
