@@ -293,6 +293,8 @@ impl NdtGrid {
                 value: levels as f64,
             });
         }
+        // The scan's RMS radius: the lever arm that makes rotation comparable
+        // with translation in the degeneracy analysis.
         let lever = (points
             .iter()
             .map(|p| p[0] * p[0] + p[1] * p[1])
@@ -362,12 +364,6 @@ impl NdtGrid {
         let information = stack.first().map_or_else(Matrix3::zeros, |d| {
             point_to_plane_information(own_cell_pairs(d, points, pose), pose)
         });
-        let lever = (points
-            .iter()
-            .map(|p| p[0] * p[0] + p[1] * p[1])
-            .sum::<f64>()
-            / points.len() as f64)
-            .sqrt();
         Ok(MatchResult {
             pose: outcome.pose,
             converged: outcome.converged,

@@ -2,6 +2,18 @@
 
 use crate::error::{check_finite, NdtError, Result};
 
+/// Checks that `angles` has one finite value per range.
+pub fn check_beams(ranges: &[f64], angles: &[f64]) -> Result<()> {
+    if ranges.len() != angles.len() {
+        return Err(NdtError::LengthMismatch {
+            what: "angles",
+            expected: ranges.len(),
+            got: angles.len(),
+        });
+    }
+    check_finite("angles", angles)
+}
+
 /// Scan-frame points `(r cos a, r sin a)` [m] of the beams whose range is
 /// valid: finite and `min_range ≤ r < max_range` (so 0, NaN, ∞ and readings at
 /// the sensor's maximum, which mean "no return", are skipped).
@@ -14,14 +26,7 @@ pub fn points_from_ranges(
     min_range: f64,
     max_range: f64,
 ) -> Result<Vec<[f64; 2]>> {
-    if ranges.len() != angles.len() {
-        return Err(NdtError::LengthMismatch {
-            what: "angles",
-            expected: ranges.len(),
-            got: angles.len(),
-        });
-    }
-    check_finite("angles", angles)?;
+    check_beams(ranges, angles)?;
     if !(min_range.is_finite() && min_range >= 0.0) {
         return Err(NdtError::InvalidOption {
             name: "min_range",

@@ -14,6 +14,7 @@ use crate::filter::observation::{check_due, CellInfo};
 use crate::filter::Beam;
 use crate::grid::NdtGrid;
 use crate::key::CellKey;
+use crate::ranges::check_beams;
 use crate::se2::Pose2;
 
 /// Which step dropped a point of the new scan.
@@ -183,14 +184,7 @@ impl MapFilter {
         angles: &[f64],
         pose: Pose2,
     ) -> Result<Vec<Beam>> {
-        if ranges.len() != angles.len() {
-            return Err(NdtError::LengthMismatch {
-                what: "angles",
-                expected: ranges.len(),
-                got: angles.len(),
-            });
-        }
-        check_finite("angles", angles)?;
+        check_beams(ranges, angles)?;
         check_finite("pose", &pose.to_array())?;
         let (lo, hi) = (self.options.min_range, self.options.max_range);
         let inv_cell = 1.0 / grid.cell_size();
