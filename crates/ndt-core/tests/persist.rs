@@ -192,6 +192,54 @@ fn files_round_trip_and_replace_the_old_file_whole() {
     }
 }
 
+// --- the layout of version 1 (frozen: a change here needs a new version) ------
+
+#[test]
+fn version_1_layout_is_frozen() {
+    use nalgebra::{Matrix2, Vector2};
+    let stats = ndt_core::CellStats {
+        count: 3,
+        sum: Vector2::new(0.125, -0.25),
+        scatter: Matrix2::new(0.5, 0.0625, 0.0625, 1.0),
+    };
+    let key = ndt_core::CellKey { ix: -3, iy: 7 };
+    let grid = NdtGrid::from_cell_states(0.5, &[(key, stats)]).unwrap();
+    // The payload, field by field (postcard: f64 as 8 bytes little-endian,
+    // integers as varints, i32 zigzag-encoded, sequences prefixed by length).
+    let mut payload = 0.5f64.to_le_bytes().to_vec(); // cell size
+    payload.push(6); // levels
+    payload.push(1); // one cell
+    payload.extend_from_slice(&[5, 14]); // ix = -3, iy = 7 (zigzag)
+    payload.push(3); // count
+    for v in [0.125f64, -0.25, 0.5, 0.0625, 0.0625, 1.0] {
+        payload.extend_from_slice(&v.to_le_bytes()); // sum, then scatter row-major
+    }
+    let mut expected = b"NDTGRID\0GRID".to_vec();
+    expected.extend_from_slice(&1u32.to_le_bytes());
+    expected.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    let mut crc = crc32fast::Hasher::new();
+    crc.update(&expected);
+    crc.update(&payload);
+    expected.extend_from_slice(&crc.finalize().to_le_bytes());
+    expected.extend_from_slice(&payload);
+    assert_eq!(grid.to_bytes().unwrap(), expected);
+    // A new mapper with the default options, byte for byte.
+    let mapper = Mapper::new(0.5, MapperOptions::default()).unwrap();
+    let hex: String = mapper
+        .to_bytes()
+        .unwrap()
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    assert_eq!(
+        hex,
+        "4e445447524944004d41505201000000760000000000000009b8c83e000000000000e03f0600010101\
+         0101010000000000000000000000000000f07f000000000000e03f9a9999999999a93f0000000000000040\
+         9a9999999999a93f00000000000000009a9999999999b93f030201b81e85eb51b89e3fb81e85eb51b88e3f\
+         7b14ae47e17a743f0000000000000000000000"
+    );
+}
+
 // --- errors ------------------------------------------------------------------
 
 fn message<T>(r: Result<T, NdtError>) -> String {
@@ -614,4 +662,84 @@ proptest! {
             prop_assert!(m.to_bytes().is_ok());
         }
     }
+
+    #[test]
+    fn arbitrary_well_formed_states_never_panic(
+        cell_size in prop_oneof![9 => Just(0.05), 1 => any::<f64>()],
+        levels in prop_oneof![9 => 1u32..=12, 1 => any::<u32>()],
+        cells in proptest::collection::vec(cell_strategy(), 0..12),
+        records in proptest::collection::vec(record_strategy(), 0..6),
+        scans in prop_oneof![9 => 20u64..60, 1 => any::<u64>()],
+        counter in prop_oneof![9 => 0u64..40, 1 => any::<u64>()],
+        gap in prop_oneof![9 => Just(0.05), 1 => any::<f64>()],
+        interval in 0u32..5,
+    ) {
+        // Well-formed encodings of arbitrary states (right checksum, every
+        // field decodable): only the validation stands between them and the
+        // map. Whatever loads must save back the same and take a scan.
+        let grid = GridV1 { cell_size, levels, cells };
+        let mut filter = wire::FilterV1::of(&Mapper::new(0.05, MapperOptions::default()).unwrap().into_parts().1);
+        filter.records = records;
+        filter.scans = scans;
+        filter.counts.confirmation_cells = counter;
+        filter.options.cluster_gap = gap;
+        filter.options.check_interval = interval;
+        let bytes = seal(FileKind::Mapper, &wire::encode(&MapperV1 { grid: grid.clone(), filter }).unwrap());
+        if let Ok(mut m) = Mapper::from_bytes(&bytes) {
+            let again = m.to_bytes().unwrap();
+            prop_assert_eq!(Mapper::from_bytes(&again).unwrap().to_bytes().unwrap(), again);
+            let angles: Vec<f64> = (0..60).map(|i| f64::from(i) * 0.05 - 1.5).collect();
+            let _ = m.insert_scan(&vec![1.5; 60], &angles, Pose2::identity());
+            let _ = m.run_checks();
+        }
+        let bytes = seal(FileKind::Grid, &wire::encode(&grid).unwrap());
+        if let Ok(g) = NdtGrid::from_bytes(&bytes) {
+            let pts: Vec<[f64; 2]> = (0..30).map(|i| [0.02 * f64::from(i), 0.1]).collect();
+            let _ = g.match_scan(&pts, Pose2::identity(), &MatchOptions::default());
+        }
+    }
+}
+
+/// A wire cell: mostly small keys and plausible sums, sometimes anything.
+fn cell_strategy() -> impl Strategy<Value = wire::CellV1> {
+    (
+        prop_oneof![9 => -5i32..5, 1 => any::<i32>()],
+        prop_oneof![9 => -5i32..5, 1 => any::<i32>()],
+        prop_oneof![9 => 1u64..10, 1 => any::<u64>()],
+        proptest::array::uniform2(prop_oneof![9 => -0.1f64..0.1, 1 => any::<f64>()]),
+        proptest::array::uniform4(prop_oneof![9 => 0.0f64..0.1, 1 => any::<f64>()]),
+    )
+        .prop_map(|(ix, iy, count, sum, scatter)| wire::CellV1 {
+            ix,
+            iy,
+            count,
+            sum,
+            scatter,
+        })
+}
+
+/// A wire filter record: mostly plausible, sometimes anything.
+fn record_strategy() -> impl Strategy<Value = wire::RecordV1> {
+    (
+        prop_oneof![9 => -5i32..5, 1 => any::<i32>()],
+        prop_oneof![9 => -5i32..5, 1 => any::<i32>()],
+        prop_oneof![9 => 1u64..20, 1 => any::<u64>()],
+        prop_oneof![9 => 0u64..20, 1 => any::<u64>()],
+        prop_oneof![9 => 1u32..5, 1 => any::<u32>()],
+        prop_oneof![9 => 0u32..2, 1 => any::<u32>()],
+        any::<bool>(),
+    )
+        .prop_map(
+            |(ix, iy, first_seen, later, observations, small_observations, seen_in_area1)| {
+                wire::RecordV1 {
+                    ix,
+                    iy,
+                    first_seen,
+                    last_seen: first_seen.saturating_add(later),
+                    observations,
+                    small_observations,
+                    seen_in_area1,
+                }
+            },
+        )
 }
