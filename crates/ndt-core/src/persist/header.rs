@@ -9,7 +9,7 @@ pub const MAGIC: [u8; 8] = *b"NDTGRID\0";
 /// The format version this build writes, and the only one it reads.
 pub const VERSION: u32 = 1;
 
-/// Length of the header [bytes].
+/// Length of the header, in bytes.
 pub const HEADER_LEN: usize = 28;
 
 /// Offset of the CRC-32: the bytes before it are the checksummed header.
