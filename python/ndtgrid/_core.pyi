@@ -134,6 +134,7 @@ class NdtGrid:
         guess: ArrayLike,
         *,
         expansion: float = 10.0,
+        sigma_floor: float = 0.02,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
         pair_neighbors: bool = False,
@@ -168,6 +169,12 @@ class NdtGrid:
             Initial pose ``[x, y, theta]`` (m, m, rad).
         expansion : float, default 10.0
             ``k`` of eq. (8): both covariance eigenvalues are multiplied by it.
+        sigma_floor : float, default 0.02
+            Smallest standard deviation [m] a cell's distribution is given before
+            the expansion: the scatter between two scans of one surface (range
+            noise, beam footprint, sampling). 2 cm was the best of 0.5-3 cm on the
+            real pairs of ``benches/convergence.py`` (BENCHMARK.md); lower it for a
+            more precise sensor.
         neighbor_search : bool, default True
             §IV-A(1): a point whose own cell has no distribution is paired with
             the distribution whose mean is nearest to it among the first ring of
@@ -234,6 +241,7 @@ class NdtGrid:
         pose: ArrayLike,
         *,
         expansion: float = 10.0,
+        sigma_floor: float = 0.02,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
         pair_neighbors: bool = False,
@@ -754,6 +762,7 @@ class OdometryLoop:
         prior_gap_distance: float | None = None,
         prior_gap_angle: float | None = None,
         expansion: float | None = None,
+        sigma_floor: float | None = None,
         neighbor_search: bool | None = None,
         fuse_minority: bool | None = None,
         search_radius: int | None = None,
