@@ -134,7 +134,7 @@ class NdtGrid:
         guess: ArrayLike,
         *,
         expansion: float = 10.0,
-        sigma_floor: float = 0.02,
+        sigma_floor: float = 0.01,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
         pair_neighbors: bool = False,
@@ -169,12 +169,13 @@ class NdtGrid:
             Initial pose ``[x, y, theta]`` (m, m, rad).
         expansion : float, default 10.0
             ``k`` of eq. (8): both covariance eigenvalues are multiplied by it.
-        sigma_floor : float, default 0.02
+        sigma_floor : float, default 0.01
             Smallest standard deviation [m] a cell's distribution is given before
             the expansion: the scatter between two scans of one surface (range
-            noise, beam footprint, sampling). 2 cm was the best of 0.5-3 cm on the
-            real pairs of ``benches/convergence.py`` (BENCHMARK.md); lower it for a
-            more precise sensor.
+            noise, beam footprint, sampling; a URG-04LX is good to +-10 mm). 1 cm
+            was the best of 0.5-3 cm over the real pairs of
+            ``benches/convergence.py`` (benchmark and held-out SICK pairs, URG-04LX
+            pairs; BENCHMARK.md); lower it for a more precise sensor.
         neighbor_search : bool, default True
             §IV-A(1): a point whose own cell has no distribution is paired with
             the distribution whose mean is nearest to it among the first ring of
@@ -241,7 +242,7 @@ class NdtGrid:
         pose: ArrayLike,
         *,
         expansion: float = 10.0,
-        sigma_floor: float = 0.02,
+        sigma_floor: float = 0.01,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
         pair_neighbors: bool = False,

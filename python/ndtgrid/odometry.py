@@ -67,7 +67,7 @@ class OdometryConfig:
         few points per 2 cm cell) 30 gave lower relation errors (``BENCHMARK.md``).
     sigma_floor : float, default 0.005
         Smallest standard deviation [m] of a cell's distribution before the expansion
-        (see :meth:`ndtgrid.NdtGrid.match`, whose scan-to-scan default is 0.02): the loop
+        (see :meth:`ndtgrid.NdtGrid.match`, whose scan-to-scan default is 0.01): the loop
         matches against a map of many scans, whose cells are well sampled (simulated
         demo: 0.36 cm RMS pose error with 5 mm, 0.94 cm with 2 cm).
     neighbor_search : bool, default True

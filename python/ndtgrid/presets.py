@@ -18,7 +18,7 @@ __all__ = ["ORIGINAL_NDT", "PAPER"]
 #: Takubo et al. (IROS 2009) alone: the fine grid only, k = 10, neighbour search (3 cells)
 #: and minority fusion, no pyramid, no rotational multi-start, no frozen directions; the
 #: covariance regularised only up to a 5 mm standard deviation (about a URG-04LX's or a
-#: SICK's range noise; the paper states none), not the default's 2 cm.
+#: SICK's range noise; the paper states none), not the default's 1 cm.
 PAPER: dict[str, Any] = {
     "levels": 1,
     "sigma_floor": 0.005,

@@ -49,7 +49,7 @@ pub struct MatchOptions {
     /// Smallest standard deviation [m] a cell's distribution is given before
     /// the expansion (> 0): the scatter between two scans of one surface
     /// (range noise, beam footprint, sampling). Default
-    /// [`DEFAULT_SIGMA_FLOOR`] (2 cm), chosen by measurement (see there);
+    /// [`DEFAULT_SIGMA_FLOOR`] (1 cm), chosen by measurement (see there);
     /// lower it for a more precise sensor.
     pub sigma_floor: f64,
     /// §IV-A(1): pair points whose own cell has no distribution with a nearby

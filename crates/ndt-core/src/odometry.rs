@@ -75,7 +75,7 @@ pub struct OdometryConfig {
     /// paper's in one place: `expansion` (`k` of eq. 8) is 30, not 10 —
     /// measured on the benchmark logs (1° SICK beams, whose 2 cm cells hold
     /// few points), where it lowered the relation error (see BENCHMARK.md).
-    /// The σ floor is 5 mm, not the scan-to-scan default of 2 cm: the loop
+    /// The σ floor is 5 mm, not the scan-to-scan default of 1 cm: the loop
     /// matches against a map of many scans, whose cells are well sampled
     /// (the simulated demo's RMS pose error: 0.36 cm with 5 mm, 0.94 cm with
     /// 2 cm).

@@ -113,7 +113,7 @@ impl PyNdtGrid {
 
     /// Matches scan-frame points against the map from `guess`.
     #[pyo3(name = "match", signature = (
-        points, guess, *, expansion = 10.0, sigma_floor = 0.02, neighbor_search = true, fuse_minority = true,
+        points, guess, *, expansion = 10.0, sigma_floor = 0.01, neighbor_search = true, fuse_minority = true,
         pair_neighbors = false, search_radius = 1, max_iterations = 50, translation_tolerance = 1e-4,
         rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, rotation_search = 0.15, freeze_unconstrained = true,
         levels = None,
@@ -175,7 +175,7 @@ impl PyNdtGrid {
 
     /// Score terms of eq. (1) at `pose` without solving.
     #[pyo3(signature = (
-        points, pose, *, expansion = 10.0, sigma_floor = 0.02, neighbor_search = true, fuse_minority = true,
+        points, pose, *, expansion = 10.0, sigma_floor = 0.01, neighbor_search = true, fuse_minority = true,
         pair_neighbors = false, search_radius = 1
     ))]
     #[allow(clippy::too_many_arguments)]
