@@ -16,21 +16,22 @@ pub const EIGEN_RATIO: f64 = 0.01;
 /// noise: ±10 mm for a URG-04LX up to 1 m and 1 % beyond, ±15 mm for a SICK
 /// LMS 2xx; plus beam footprint and sampling) pulls the match towards where
 /// one scan happened to sample a surface rather than onto the surface.
-/// Measured with `benches/convergence.py` (2 cm grid, default match; success
-/// with local / wide starts) on the 120 benchmark SICK pairs, on 120 held-out
-/// SICK pairs between them (`--held-out`), on 11 URG-04LX pairs and on 16
-/// simulated pairs (wide):
+/// Measured with `benches/sigma_floor.py` (2 cm grid, default match; success
+/// with local / wide starts) on the 120 SICK pairs of `benches/convergence.py`,
+/// on the 120 held-out SICK pairs between them, on 11 URG-04LX pairs and on 16
+/// simulated pairs:
 ///
 /// | floor | SICK pairs | held-out SICK pairs | URG-04LX pairs | simulated |
 /// |---|---|---|---|---|
-/// | 5 mm | 76.6 / 74.8 % | 74.5 / 73.2 % | 81.8 / 77.3 % | 95.3 % |
-/// | 10 mm | 79.5 / 78.1 % | 74.7 / 73.2 % | 90.9 / 88.6 % | 93.8 % |
-/// | 15 mm | 80.1 / 78.5 % | 74.0 / 72.9 % | 90.9 / 87.5 % | 96.1 % |
-/// | 20 mm | 81.0 / 79.0 % | 73.1 / 72.0 % | 90.9 / 88.6 % | 99.2 % |
-/// | 30 mm | 79.5 / 77.9 % | 71.1 / 70.8 % | 90.9 / 90.9 % | 100 % |
+/// | 5 mm | 76.6 / 74.8 % | 74.6 / 73.2 % | 81.8 / 77.3 % | 100 / 95.3 % |
+/// | 10 mm | 79.5 / 78.1 % | 74.8 / 73.4 % | 90.9 / 88.6 % | 100 / 93.8 % |
+/// | 15 mm | 80.1 / 78.5 % | 74.1 / 72.8 % | 90.9 / 87.5 % | 100 / 96.1 % |
+/// | 20 mm | 81.0 / 79.0 % | 73.1 / 71.9 % | 90.9 / 88.6 % | 100 / 99.2 % |
+/// | 30 mm | 79.5 / 77.9 % | 71.4 / 70.1 % | 90.9 / 90.9 % | 100 / 100 % |
 ///
 /// The gains on the benchmark pairs above 1 cm did not carry over to the
-/// held-out pairs; 1 cm is the best or tied on every set of real pairs.
+/// held-out pairs; 1 cm is the best or tied on every set of real pairs, and
+/// a URG-04LX's data-sheet accuracy.
 pub const DEFAULT_SIGMA_FLOOR: f64 = 0.01;
 
 /// Fewest points that form a distribution (§III-B: `M ≥ 3`).
