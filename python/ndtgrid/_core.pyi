@@ -208,10 +208,11 @@ class NdtGrid:
             angle and keeps the best score; 0 turns it off.
         freeze_unconstrained : bool, default True
             From the second pyramid stage on, project Newton steps onto the
-            pose directions the scan constrains (point-to-plane information,
-            see ``MatchResult.unconstrained``): along a corridor's axis the
-            pose stays where the guess and the coarse stages put it instead of
-            being dragged by fine cells ("solution remapping").
+            pose directions the scan constrains well (point-to-plane information:
+            curvature at least 10 % of the strongest, a stricter test than the 2 %
+            of ``MatchResult.unconstrained``): along a corridor's axis the pose
+            stays where the guess and the coarse stages put it instead of being
+            dragged by fine cells ("solution remapping").
         levels : int, optional
             Pyramid levels to match on, coarse to fine (1 = the fine grid only,
             the paper's method; at most the grid's ``levels``). By default as
