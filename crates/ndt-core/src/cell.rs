@@ -113,7 +113,8 @@ pub struct Gaussian {
 impl Gaussian {
     /// eq. (7) from statistics about `origin`, regularised (see [`EIGEN_RATIO`],
     /// [`sigma_floor`]) and expanded by `k` (eq. 8: both eigenvalues
-    /// times `k`, eigenvectors kept). `None` below [`MIN_POINTS`] points.
+    /// times `k`, eigenvectors kept). `None` below [`MIN_POINTS`] points, and
+    /// when `k` or the cell size is so extreme that `Σ'⁻¹` is not finite.
     pub fn from_stats(
         stats: &CellStats,
         origin: Vector2<f64>,
@@ -132,6 +133,11 @@ impl Gaussian {
         let (e1, e2) = (k * l1, k * l2);
         let v2 = Vector2::new(-v1.y, v1.x);
         let inverse = v1 * v1.transpose() / e1 + v2 * v2.transpose() / e2;
+        // An extreme `k` or cell size (k·σ² below the smallest normal f64)
+        // would give an infinite inverse and NaN scores: no distribution.
+        if !inverse.iter().all(|v| v.is_finite()) {
+            return None;
+        }
         Some(Gaussian {
             mean: origin + q,
             inverse,

@@ -385,3 +385,49 @@ proptest! {
         }
     }
 }
+
+/// The case the match property found at scale (before the fix: score NaN): a
+/// tiny but valid expansion `k` made `k·σ²` subnormal, the inverse covariance
+/// infinite and the score NaN.
+#[test]
+fn a_subnormal_expansion_gives_a_finite_score() {
+    let grid = room_grid();
+    let options = MatchOptions {
+        expansion: 1.2903343324094226e-308,
+        neighbor_search: false,
+        search_radius: 0,
+        fuse_minority: false,
+        pair_neighbors: true,
+        max_iterations: 0,
+        translation_tolerance: 1e-6,
+        rotation_tolerance: 1e-6,
+        max_step_cells: 0.5,
+        max_step_rotation: 0.01,
+        rotation_search: 0.0,
+        freeze_unconstrained: false,
+        levels: None,
+    };
+    let pts = [[-2.3763401613489026, 2.3516387683799254]];
+    let r = grid
+        .match_scan(&pts, Pose2::new(0.0, 0.0, -1.9098511669164244), &options)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(r.score.is_finite() && r.pose.to_array().iter().all(|v| v.is_finite()));
+    for k in [1e-300, 1e-320, 1e300] {
+        let o = MatchOptions {
+            expansion: k,
+            max_iterations: 20,
+            ..options
+        };
+        let r = grid
+            .match_scan(
+                &common::scan(&common::room(), Pose2::identity(), 90, 3.0, 0.0, 3),
+                Pose2::identity(),
+                &o,
+            )
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            r.score.is_finite() && r.pose.to_array().iter().all(|v| v.is_finite()),
+            "k = {k}"
+        );
+    }
+}
