@@ -13,7 +13,8 @@
 //!
 //! Every `SOAK_EVERY` scans (default 10 000) it samples the resident memory
 //! (`VmRSS`, and its peak `VmHWM`, from `/proc/self/status`) and the cell
-//! counts, printing them and writing `SOAK_OUT` (default `target/soak.csv`);
+//! counts, printing them and writing `SOAK_OUT` (default `target/soak.csv` of
+//! the workspace; a relative `SOAK_OUT` is relative to `crates/ndt-core`);
 //! `python benches/soak_plot.py target/soak.csv` draws it. A short run:
 //! `SOAK_SCANS=20000 SOAK_ODOMETRY_SCANS=2000 cargo bench --bench soak`.
 
@@ -98,7 +99,9 @@ fn main() {
     let scans = env("SOAK_SCANS", 1_000_000);
     let odo_scans = env("SOAK_ODOMETRY_SCANS", 1_000_000);
     let every = env("SOAK_EVERY", 10_000).max(1);
-    let out = std::env::var("SOAK_OUT").unwrap_or_else(|_| "target/soak.csv".into());
+    // `cargo bench` runs in the crate's directory: default to the workspace's target/.
+    let out = std::env::var("SOAK_OUT")
+        .unwrap_or_else(|_| concat!(env!("CARGO_MANIFEST_DIR"), "/../../target/soak.csv").into());
     let walls = common::room();
     let mut log = Log {
         csv: "phase,scans,rss_kib,peak_kib,cells,filter_records,poses,elapsed_s\n".into(),
