@@ -72,7 +72,7 @@ impl ScoreTerms {
         // in the derivatives would be NaN with extreme options); an e of NaN
         // (∞ − ∞ from a huge inverse covariance) likewise. For every other
         // point this changes no bit: the skipped terms are exact zeros.
-        if !(s > 0.0) {
+        if s.is_nan() || s <= 0.0 {
             return;
         }
         self.score += s;

@@ -69,7 +69,7 @@ pub fn walk_cells_in(
         }
     }
     // Also rejects NaN.
-    if !(t0 <= t1) {
+    if t0.partial_cmp(&t1).is_none_or(|o| o == std::cmp::Ordering::Greater) {
         return;
     }
     let length = delta.norm();
