@@ -69,7 +69,10 @@ pub fn walk_cells_in(
         }
     }
     // Also rejects NaN.
-    if t0.partial_cmp(&t1).is_none_or(|o| o == std::cmp::Ordering::Greater) {
+    if t0
+        .partial_cmp(&t1)
+        .is_none_or(|o| o == std::cmp::Ordering::Greater)
+    {
         return;
     }
     let length = delta.norm();
