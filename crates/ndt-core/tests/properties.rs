@@ -18,7 +18,7 @@
 //! - `Odometry::step`: random scans, odometry and invalid readings; a failed
 //!   step changes nothing.
 //!
-//! Case count: `PROPTEST_CASES` (default 32 per property, a few seconds in
+//! Case count: `PROPTEST_CASES` (default 16 per property, a few seconds in
 //! CI). The run at scale recorded in BENCHMARK.md ("Reliability (issue 6)"):
 //!
 //! ```text
@@ -42,7 +42,7 @@ fn config() -> ProptestConfig {
     let cases = std::env::var("PROPTEST_CASES")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(32);
+        .unwrap_or(16);
     ProptestConfig {
         cases,
         failure_persistence: Some(Box::new(FileFailurePersistence::Off)),
