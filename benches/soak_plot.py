@@ -31,6 +31,8 @@ def main() -> None:
         if phase == "odometry":
             poses = [int(r["poses"]) * 24 / 2**20 for r in sel]
             mem.plot(scans, poses, ":", label="pose history (24 B/scan)")
+            rest = [int(r["rss_kib"]) / 1024 - p for r, p in zip(sel, poses)]
+            mem.plot(scans, rest, "-.", label="resident - pose history")
         mem.set_ylabel("MiB")
         mem.set_ylim(bottom=0)
         mem.set_title(f"{phase}: {scans[-1]:,} scans")
