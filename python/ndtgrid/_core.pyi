@@ -93,10 +93,14 @@ class NdtGrid:
 
     Notes
     -----
-    Thread safety: any number of threads may call :meth:`match`,
-    :meth:`evaluate`, :meth:`cells` at once (the GIL is released while they
-    run); :meth:`insert` waits for them and runs alone. Every method either
-    succeeds or leaves the map unchanged.
+    Thread safety: many readers, one exclusive writer. Any number of threads
+    may call :meth:`match`, :meth:`evaluate`, :meth:`cells`,
+    :meth:`cell_states` at once (the GIL is released while they run);
+    :meth:`insert` waits for them and runs alone. A match sees the map as it
+    was between two inserts, never half an insert, and its result is bit for
+    bit that of matching that state alone (distributions are prepared lazily
+    but are a function of the cells' sums only). Every method either succeeds
+    or leaves the map unchanged.
     """
 
     def __init__(self, cell_size: float = 0.02, *, levels: int = 6) -> None: ...
@@ -569,10 +573,12 @@ class Mapper:
     -----
     :attr:`grid` is the same map, not a copy: matching against it sees every
     insert and removal. Inserting into it directly bypasses the filter (such
-    cells count as established, big objects). Thread safety: any number of
-    threads may read (``grid.match``, :meth:`occupied_cells`, ...) while no
-    scan is being inserted; :meth:`insert_scan` runs alone. The GIL is released
-    while the core works. A failed call leaves the map and the filter unchanged.
+    cells count as established, big objects). Thread safety: many readers,
+    one exclusive writer: any number of threads may read (``grid.match``,
+    :meth:`occupied_cells`, ...) while no scan is being inserted;
+    :meth:`insert_scan` and :meth:`run_checks` run alone (inserts from several
+    threads are serialized, each scan counted once). The GIL is released while
+    the core works. A failed call leaves the map and the filter unchanged.
 
     Examples
     --------
@@ -598,7 +604,7 @@ class Mapper:
         """Cell size [m]."""
     @property
     def scan_count(self) -> int:
-        """Scans inserted so far."""
+        """Scans inserted so far (a scan without a valid beam is not counted)."""
     def __len__(self) -> int:
         """Number of occupied cells."""
     def insert_scan(self, ranges: ArrayLike, angles: ArrayLike, pose: ArrayLike) -> None:
@@ -614,8 +620,10 @@ class Mapper:
         Parameters
         ----------
         ranges : array_like, shape (B,)
-            Ranges [m]. Beams whose range is 0, NaN, infinite, below
-            ``min_range`` or at or above ``max_range`` are skipped.
+            Ranges [m]. Beams whose range is 0, negative, NaN, infinite, below
+            ``min_range`` or at or above ``max_range`` are skipped; a scan with
+            no valid beam (``B = 0`` included) changes nothing, not even
+            :attr:`scan_count`.
         angles : array_like, shape (B,)
             Beam angles in the sensor frame [rad], in beam order (clustering
             follows it); must be finite.
@@ -738,6 +746,11 @@ class OdometryStep:
 
 class OdometryLoop:
     """The core's scan-to-map odometry loop (wrapped by :class:`ndtgrid.Odometry`).
+
+    Thread safety: one lock, taken with the GIL released (also by the getters,
+    which wait for a running :meth:`step`). Calls from several threads neither
+    crash nor deadlock, but steps from two threads interleave in the order
+    the lock gives: feed a loop from one thread, read it from any.
 
     Keyword arguments left at ``None`` take the core's defaults
     (:func:`default_odometry_config`); see :class:`ndtgrid.OdometryConfig` for

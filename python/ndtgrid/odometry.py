@@ -164,6 +164,16 @@ class Odometry:
 
     Notes
     -----
+    Thread safety: calls from several threads neither crash nor deadlock (the core
+    holds one lock, taken with the GIL released), but the loop is sequential: steps
+    from two threads interleave in whatever order the lock gives, and
+    :attr:`last_step` is the last step of either. Feed one loop from one thread and
+    read it (:attr:`poses`, :attr:`mapper`, :meth:`grid`) from any. ``step`` takes no
+    timestamps; an odometry jump is taken as motion, and when the match from it fails
+    the constant-velocity prior is tried. A scan with no valid beam gives the
+    predicted pose (recorded) and changes no map. Memory: the map is bounded by
+    ``map_window``; the pose history grows by 24 bytes a scan by design.
+
     ``odo.mapper`` (the §V outlier elimination of ``ndtgrid.Mapper``) arrives with the
     Mapper; until then the map is a plain :class:`~ndtgrid.NdtGrid` (a copy: :meth:`grid`).
     Every map change goes through one function of the core, ``Odometry::update_map``.

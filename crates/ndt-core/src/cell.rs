@@ -131,7 +131,8 @@ impl Gaussian {
     /// at least [`EIGEN_RATIO`] of the large one, both standard deviations at
     /// least `sigma_floor` [m], see [`DEFAULT_SIGMA_FLOOR`]) and expanded by
     /// `k` (eq. 8: both eigenvalues times `k`, eigenvectors kept). `None`
-    /// below [`MIN_POINTS`] points.
+    /// below [`MIN_POINTS`] points, and when `k` or `sigma_floor` is so
+    /// extreme that `Σ'⁻¹` is not finite.
     pub fn from_stats(
         stats: &CellStats,
         origin: Vector2<f64>,
@@ -150,6 +151,11 @@ impl Gaussian {
         let (e1, e2) = (k * l1, k * l2);
         let v2 = Vector2::new(-v1.y, v1.x);
         let inverse = v1 * v1.transpose() / e1 + v2 * v2.transpose() / e2;
+        // An extreme `k` or σ floor (k·σ² below the smallest normal f64)
+        // would give an infinite inverse and NaN scores: no distribution.
+        if !inverse.iter().all(|v| v.is_finite()) {
+            return None;
+        }
         Some(Gaussian {
             mean: origin + q,
             inverse,

@@ -170,6 +170,17 @@ impl OdometryConfig {
                 value: self.min_match_ratio,
             });
         }
+        // The loop's grids have the default pyramid: refuse a level count
+        // they cannot match with now, not at the second scan.
+        if let Some(l) = self.matcher.levels {
+            if l == 0 || l as usize > crate::grid::DEFAULT_LEVELS {
+                return Err(NdtError::InvalidOption {
+                    name: "levels",
+                    expected: "between 1 and 6 pyramid levels (the loop's grid has 6)",
+                    value: f64::from(l),
+                });
+            }
+        }
         self.matcher.validate()
     }
 }

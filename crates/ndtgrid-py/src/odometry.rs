@@ -90,6 +90,12 @@ impl PyOdometry {
     fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, Odometry>> {
         self.inner.lock().map_err(|_| poisoned())
     }
+
+    /// Runs `f` on the loop with the GIL released: waiting for another
+    /// thread's `step` must not stall every other Python thread.
+    fn with<T: Send>(&self, py: Python<'_>, f: impl FnOnce(&Odometry) -> T + Send) -> PyResult<T> {
+        py.detach(|| self.lock().map(|o| f(&o)))
+    }
 }
 
 #[pymethods]
@@ -221,40 +227,39 @@ impl PyOdometry {
     /// `(T, 3)` pose of every scan so far.
     #[getter]
     fn poses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let flat: Vec<f64> = {
-            let odo = self.lock()?;
-            odo.poses().iter().flat_map(|p| p.to_array()).collect()
-        };
+        let flat: Vec<f64> = self.with(py, |o| {
+            o.poses().iter().flat_map(|p| p.to_array()).collect()
+        })?;
         let t = flat.len() / 3;
         PyArray1::from_vec(py, flat).reshape([t, 3])
     }
 
     /// Scans added to the map so far.
     #[getter]
-    fn insertions(&self) -> PyResult<u64> {
-        Ok(self.lock()?.insertions())
+    fn insertions(&self, py: Python<'_>) -> PyResult<u64> {
+        self.with(py, Odometry::insertions)
     }
 
     /// Cells in the map now.
-    fn __len__(&self) -> PyResult<usize> {
-        Ok(self.lock()?.grid().len())
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.with(py, |o| o.grid().len())
     }
 
     /// A copy of the map.
     fn grid(&self, py: Python<'_>) -> PyResult<PyNdtGrid> {
-        let grid = py.detach(|| self.lock().map(|o| o.grid().clone()))?;
+        let grid = self.with(py, |o| o.grid().clone())?;
         Ok(PyNdtGrid::from(grid))
     }
 
     /// A copy of the mapper (grid and §V filter state) as of this call.
     fn mapper(&self, py: Python<'_>) -> PyResult<crate::mapper::PyMapper> {
-        let mapper = py.detach(|| self.lock().map(|o| o.mapper().clone()))?;
+        let mapper = self.with(py, |o| o.mapper().clone())?;
         crate::mapper::PyMapper::from_core(py, mapper)
     }
 
     /// The settings in force, as keyword arguments of the constructor.
     fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let c = *self.lock()?.config();
+        let c = self.with(py, |o| *o.config())?;
         config_dict(py, &c)
     }
 }
