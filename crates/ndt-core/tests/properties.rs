@@ -236,6 +236,7 @@ proptest! {
         pts in points(80),
         guess in pose(),
         expansion in prop_oneof![0.5..50.0f64, Just(1e-300), Just(1e300), wild()],
+        sigma_floor in prop_oneof![0.001..0.05f64, Just(1e-300), Just(1e300), wild()],
         tol in prop_oneof![1e-6..1e-2f64, Just(1e-300), Just(1e300), wild()],
         max_step_cells in prop_oneof![0.5..5.0f64, Just(1e-300), Just(1e300), wild()],
         max_step_rotation in prop_oneof![0.01..0.5f64, Just(1e300), wild()],
@@ -248,6 +249,7 @@ proptest! {
         let grid = room_grid();
         let options = MatchOptions {
             expansion,
+            sigma_floor,
             neighbor_search: flags[0],
             search_radius,
             fuse_minority: flags[1],
@@ -394,6 +396,7 @@ fn a_subnormal_expansion_gives_a_finite_score() {
     let grid = room_grid();
     let options = MatchOptions {
         expansion: 1.2903343324094226e-308,
+        sigma_floor: 0.005,
         neighbor_search: false,
         search_radius: 0,
         fuse_minority: false,
