@@ -90,6 +90,21 @@ def wait_until(condition: Callable[[], bool], timeout: float = 30.0) -> None:
         time.sleep(0.0005)
 
 
+def run_writers_then_stop_readers(
+    writers: list[threading.Thread], readers: list[threading.Thread], stop: threading.Event
+) -> None:
+    """Start every thread, wait for the writers, then stop and join the readers; fail if
+    any thread is still alive after its timeout (a deadlock)."""
+    for t in writers + readers:
+        t.start()
+    for t in writers:
+        t.join(JOIN_TIMEOUT)
+    stop.set()
+    for t in readers:
+        t.join(JOIN_TIMEOUT)
+    assert not any(t.is_alive() for t in writers + readers), "deadlock"
+
+
 def insert_grid(g: ndtgrid.NdtGrid, k: int) -> None:
     g.insert(*SCANS[k])
 
@@ -194,14 +209,7 @@ def test_mapper_shared_by_threads_neither_deadlocks_nor_crashes() -> None:
 
     writers = [threading.Thread(target=writer, args=(ks,)) for ks in ([1, 3, 5, 7], [2, 4, 6, 8])]
     readers = [threading.Thread(target=reader, daemon=True) for _ in range(2)]
-    for t in writers + readers:
-        t.start()
-    for t in writers:
-        t.join(JOIN_TIMEOUT)
-    stop.set()
-    for t in readers:
-        t.join(JOIN_TIMEOUT)
-    assert not any(t.is_alive() for t in writers + readers), "deadlock"
+    run_writers_then_stop_readers(writers, readers, stop)
     assert not errors, errors
     assert m.scan_count == 9
 
@@ -238,13 +246,6 @@ def test_odometry_shared_by_threads_neither_deadlocks_nor_crashes() -> None:
 
     steppers = [threading.Thread(target=stepper) for _ in range(2)]
     readers = [threading.Thread(target=reader, daemon=True)]
-    for t in steppers + readers:
-        t.start()
-    for t in steppers:
-        t.join(JOIN_TIMEOUT)
-    stop.set()
-    for t in readers:
-        t.join(JOIN_TIMEOUT)
-    assert not any(t.is_alive() for t in steppers + readers), "deadlock"
+    run_writers_then_stop_readers(steppers, readers, stop)
     assert not errors, errors
     assert odo.poses.shape == (12, 3)
