@@ -11,7 +11,7 @@ which two independent peers agree (see :func:`urg_pairs`). Simulated pairs come
 from ``ndtgrid.sim`` (the sticks room, URG-04LX and
 SICK-like presets, with the simulator's noise and false detections).
 
-Run: ``python benches/convergence.py [--pairs 12] [--starts 8] [--sim-pairs 8]``;
+Run: ``python benches/convergence.py [--pairs 12] [--starts 8] [--sim-pairs 8] [--held-out]``;
 prints a Markdown table per pair set and start set.
 """
 
@@ -106,8 +106,9 @@ def sim_pairs(count: int, seed: int = 0) -> Iterator[Pair]:
             yield Pair(f"sim {laser.name}", apply(a, pa), pb, b, (0.02, np.radians(0.5)))
 
 
-def real_pairs(per_log: int) -> Iterator[Pair]:
-    """``per_log`` consecutive corrected pairs spread evenly over each log."""
+def real_pairs(per_log: int, held_out: bool = False) -> Iterator[Pair]:
+    """``per_log`` consecutive corrected pairs spread evenly over each log; with
+    ``held_out``, the pairs half-way between those (a set no default was chosen on)."""
     for name, (log, csv) in LOGS.items():
         if not (REAL / "radish-gfs-corrected" / log).exists():
             print(f"skipped {name}: ../shared/data/real absent")
@@ -115,7 +116,10 @@ def real_pairs(per_log: int) -> Iterator[Pair]:
         scans = list(read_carmen(REAL / "radish-gfs-corrected" / log))
         index = read_benchmark_index(REAL / "benchmark-scans-split" / csv)
         pairs = list(corrected_pairs(scans, index, max_range=MAX_RANGE))
-        for k in np.linspace(0, len(pairs) - 1, per_log).astype(int):
+        at = np.linspace(0, len(pairs) - 1, per_log + held_out)
+        if held_out:
+            at = 0.5 * (at[:-1] + at[1:])
+        for k in at.astype(int):
             p = pairs[k]
             target = apply(p.reference_pose, p.reference_points)
             yield Pair(name, target, p.points, p.true_pose)
@@ -207,10 +211,18 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--sim-pairs", type=int, default=8, help="pairs per simulated laser")
     ap.add_argument("--urg-pairs", type=int, default=40, help="candidate pairs of the URG log")
+    ap.add_argument(
+        "--held-out",
+        action="store_true",
+        help="real pairs half-way between the default ones (a set no default was tuned on)",
+    )
     args = ap.parse_args()
     ms = methods()
     sets = [
-        ("Real pairs", list(real_pairs(args.pairs))),
+        (
+            "Held-out real pairs" if args.held_out else "Real pairs",
+            list(real_pairs(args.pairs, args.held_out)),
+        ),
         ("Real URG-04LX pairs (peer-consensus reference)", list(urg_pairs(args.urg_pairs))),
         ("Simulated pairs", list(sim_pairs(args.sim_pairs, args.seed))),
     ]

@@ -21,5 +21,8 @@ scan = room @ np.array([[c, s], [-s, c]]) + inv[:2]
 
 result = grid.match(scan, [0.0, 0.0, 0.0])  # start from "no motion"
 print(result)
-print("error [mm, deg]:", np.round(1e3 * np.hypot(*(result.pose - true_pose)[:2]), 3),
-      np.round(np.degrees(result.pose[2] - true_pose[2]), 4))
+print(
+    "error [mm, deg]:",
+    np.round(1e3 * np.hypot(*(result.pose - true_pose)[:2]), 3),
+    np.round(np.degrees(result.pose[2] - true_pose[2]), 4),
+)

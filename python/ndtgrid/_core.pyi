@@ -96,10 +96,14 @@ class NdtGrid:
 
     Notes
     -----
-    Thread safety: any number of threads may call :meth:`match`,
-    :meth:`evaluate`, :meth:`cells` at once (the GIL is released while they
-    run); :meth:`insert` waits for them and runs alone. Every method either
-    succeeds or leaves the map unchanged.
+    Thread safety: many readers, one exclusive writer. Any number of threads
+    may call :meth:`match`, :meth:`evaluate`, :meth:`cells`,
+    :meth:`cell_states` at once (the GIL is released while they run);
+    :meth:`insert` waits for them and runs alone. A match sees the map as it
+    was between two inserts, never half an insert, and its result is bit for
+    bit that of matching that state alone (distributions are prepared lazily
+    but are a function of the cells' sums only). Every method either succeeds
+    or leaves the map unchanged.
     """
 
     def __init__(self, cell_size: float = 0.02, *, levels: int = 6) -> None: ...
@@ -137,6 +141,7 @@ class NdtGrid:
         guess: ArrayLike,
         *,
         expansion: float = 10.0,
+        sigma_floor: float = 0.01,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
         pair_neighbors: bool = False,
@@ -171,6 +176,13 @@ class NdtGrid:
             Initial pose ``[x, y, theta]`` (m, m, rad).
         expansion : float, default 10.0
             ``k`` of eq. (8): both covariance eigenvalues are multiplied by it.
+        sigma_floor : float, default 0.01
+            Smallest standard deviation [m] a cell's distribution is given before
+            the expansion: the scatter between two scans of one surface (range
+            noise, beam footprint, sampling; a URG-04LX is good to +-10 mm). 1 cm
+            was the best of 0.5-3 cm over the real pairs of
+            ``benches/convergence.py`` (benchmark and held-out SICK pairs, URG-04LX
+            pairs; BENCHMARK.md); lower it for a more precise sensor.
         neighbor_search : bool, default True
             §IV-A(1): a point whose own cell has no distribution is paired with
             the distribution whose mean is nearest to it among the first ring of
@@ -203,10 +215,11 @@ class NdtGrid:
             angle and keeps the best score; 0 turns it off.
         freeze_unconstrained : bool, default True
             From the second pyramid stage on, project Newton steps onto the
-            pose directions the scan constrains (point-to-plane information,
-            see ``MatchResult.unconstrained``): along a corridor's axis the
-            pose stays where the guess and the coarse stages put it instead of
-            being dragged by fine cells ("solution remapping").
+            pose directions the scan constrains well (point-to-plane information:
+            curvature at least 10 % of the strongest, a stricter test than the 2 %
+            of ``MatchResult.unconstrained``): along a corridor's axis the pose
+            stays where the guess and the coarse stages put it instead of being
+            dragged by fine cells ("solution remapping").
         levels : int, optional
             Pyramid levels to match on, coarse to fine (1 = the fine grid only,
             the paper's method; at most the grid's ``levels``). By default as
@@ -237,6 +250,7 @@ class NdtGrid:
         pose: ArrayLike,
         *,
         expansion: float = 10.0,
+        sigma_floor: float = 0.01,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
         pair_neighbors: bool = False,
@@ -640,10 +654,12 @@ class Mapper:
     -----
     :attr:`grid` is the same map, not a copy: matching against it sees every
     insert and removal. Inserting into it directly bypasses the filter (such
-    cells count as established, big objects). Thread safety: any number of
-    threads may read (``grid.match``, :meth:`occupied_cells`, ...) while no
-    scan is being inserted; :meth:`insert_scan` runs alone. The GIL is released
-    while the core works. A failed call leaves the map and the filter unchanged.
+    cells count as established, big objects). Thread safety: many readers,
+    one exclusive writer: any number of threads may read (``grid.match``,
+    :meth:`occupied_cells`, ...) while no scan is being inserted;
+    :meth:`insert_scan` and :meth:`run_checks` run alone (inserts from several
+    threads are serialized, each scan counted once). The GIL is released while
+    the core works. A failed call leaves the map and the filter unchanged.
 
     Examples
     --------
@@ -669,7 +685,7 @@ class Mapper:
         """Cell size [m]."""
     @property
     def scan_count(self) -> int:
-        """Scans inserted so far."""
+        """Scans inserted so far (a scan without a valid beam is not counted)."""
     def __len__(self) -> int:
         """Number of occupied cells."""
     def insert_scan(self, ranges: ArrayLike, angles: ArrayLike, pose: ArrayLike) -> None:
@@ -685,8 +701,10 @@ class Mapper:
         Parameters
         ----------
         ranges : array_like, shape (B,)
-            Ranges [m]. Beams whose range is 0, NaN, infinite, below
-            ``min_range`` or at or above ``max_range`` are skipped.
+            Ranges [m]. Beams whose range is 0, negative, NaN, infinite, below
+            ``min_range`` or at or above ``max_range`` are skipped; a scan with
+            no valid beam (``B = 0`` included) changes nothing, not even
+            :attr:`scan_count`.
         angles : array_like, shape (B,)
             Beam angles in the sensor frame [rad], in beam order (clustering
             follows it); must be finite.
@@ -866,6 +884,11 @@ class OdometryStep:
 class OdometryLoop:
     """The core's scan-to-map odometry loop (wrapped by :class:`ndtgrid.Odometry`).
 
+    Thread safety: one lock, taken with the GIL released (also by the getters,
+    which wait for a running :meth:`step`). Calls from several threads neither
+    crash nor deadlock, but steps from two threads interleave in the order
+    the lock gives: feed a loop from one thread, read it from any.
+
     Keyword arguments left at ``None`` take the core's defaults
     (:func:`default_odometry_config`); see :class:`ndtgrid.OdometryConfig` for
     their meaning and units.
@@ -891,6 +914,7 @@ class OdometryLoop:
         prior_gap_distance: float | None = None,
         prior_gap_angle: float | None = None,
         expansion: float | None = None,
+        sigma_floor: float | None = None,
         neighbor_search: bool | None = None,
         fuse_minority: bool | None = None,
         search_radius: int | None = None,

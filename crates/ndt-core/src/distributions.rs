@@ -17,6 +17,9 @@ pub struct DistOptions {
     /// §IV-A(3): a cell with fewer than 3 points takes the distribution of the
     /// summed eq. (6) terms of itself and its 8 neighbours.
     pub fuse_minority: bool,
+    /// Smallest standard deviation of a distribution before expansion [m]
+    /// (see [`crate::cell::DEFAULT_SIGMA_FLOOR`]).
+    pub sigma_floor: f64,
 }
 
 /// The distribution of every cell that has one, for one [`DistOptions`].
@@ -129,7 +132,7 @@ fn distribution_of(
     let own = cells.get(&key)?;
     let centre = key.center(cell_size);
     if own.count >= MIN_POINTS || !options.fuse_minority {
-        return Gaussian::from_stats(own, centre, cell_size, options.expansion);
+        return Gaussian::from_stats(own, centre, options.sigma_floor, options.expansion);
     }
     // §IV-A(3): fuse the minority cell with its neighbours. The neighbours'
     // sums are about their own centres; re-express them about this one.
@@ -142,5 +145,5 @@ fn distribution_of(
             }
         }
     }
-    Gaussian::from_stats(&fused, centre, cell_size, options.expansion)
+    Gaussian::from_stats(&fused, centre, options.sigma_floor, options.expansion)
 }

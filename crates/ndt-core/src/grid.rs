@@ -9,7 +9,7 @@ use rustc_hash::FxHashMap;
 use crate::cell::CellStats;
 use crate::distributions::{DistOptions, Distributions};
 use crate::error::{check_finite, NdtError, Result};
-use crate::key::{CellKey, MAX_INDEX};
+use crate::key::{CellKey, KeyBounds, MAX_INDEX};
 use crate::pyramid::{Level, Pyramid, MAX_LEVELS};
 use crate::se2::Pose2;
 
@@ -222,6 +222,13 @@ impl NdtGrid {
             }
         }
         removed
+    }
+
+    /// A rectangle of cell indices holding every occupied cell (possibly more:
+    /// removals do not shrink it until the grid is empty); `None` for an
+    /// empty grid. Walks along a beam use it to skip where no cell can be.
+    pub fn key_bounds(&self) -> Option<KeyBounds> {
+        self.pyramid.bounds()
     }
 
     /// Keys of every occupied cell, in no particular order.

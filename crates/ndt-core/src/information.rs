@@ -1,6 +1,7 @@
 //! The geometric information a scan carries about its pose: the point-to-plane
 //! information matrix `Σ Jᵢᵀ nᵢ nᵢᵀ Jᵢ`, with `nᵢ` the normal (the direction
-//! of least spread) of the distribution point `i` is paired with.
+//! of least spread, before regularisation: [`crate::cell::Gaussian::normal`])
+//! of the distribution point `i` is paired with.
 //!
 //! Unlike the Hessian of the fine-grid score, it does not count the
 //! cell-to-cell texture along a wall as information: a long corridor carries
@@ -8,7 +9,6 @@
 
 use nalgebra::{Matrix3, Vector2, Vector3};
 
-use crate::cell::symmetric_eigen2;
 use crate::distributions::Distributions;
 use crate::se2::Pose2;
 
@@ -21,10 +21,7 @@ pub fn point_to_plane_information<'a>(
     let (s, c) = pose.theta.sin_cos();
     let mut a = Matrix3::zeros();
     for (x, g) in pairs {
-        // The normal: the eigenvector of Σ⁻¹'s largest eigenvalue, i.e. of
-        // Σ's smallest.
-        let (_, _, v) = symmetric_eigen2(&g.inverse);
-        let n = v;
+        let n = g.normal;
         let jt = Vector3::new(
             n.x,
             n.y,

@@ -53,3 +53,42 @@ impl CellKey {
         }
     }
 }
+
+/// An inclusive rectangle of cell indices: a superset of the occupied cells
+/// of a grid (see [`crate::NdtGrid::key_bounds`]), so that walks along a beam
+/// can skip the part that lies where no cell is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KeyBounds {
+    /// Smallest `ix` and `iy`.
+    pub min: CellKey,
+    /// Largest `ix` and `iy`.
+    pub max: CellKey,
+}
+
+impl KeyBounds {
+    /// The bounds of the single cell `key`.
+    pub fn of(key: CellKey) -> Self {
+        Self { min: key, max: key }
+    }
+
+    /// The bounds grown to hold `key` too.
+    pub fn including(self, key: CellKey) -> Self {
+        Self {
+            min: CellKey {
+                ix: self.min.ix.min(key.ix),
+                iy: self.min.iy.min(key.iy),
+            },
+            max: CellKey {
+                ix: self.max.ix.max(key.ix),
+                iy: self.max.iy.max(key.iy),
+            },
+        }
+    }
+
+    /// The bounds of `keys`, `None` when there are none.
+    pub fn of_keys(keys: impl IntoIterator<Item = CellKey>) -> Option<Self> {
+        keys.into_iter().fold(None, |b: Option<Self>, k| {
+            Some(b.map_or_else(|| Self::of(k), |b| b.including(k)))
+        })
+    }
+}

@@ -44,7 +44,7 @@ pub use error::{NdtError, Result};
 pub use filter::objects::SmallObject;
 pub use freespace::{FreeSpace, Raster};
 pub use grid::{CellRecord, NdtGrid};
-pub use key::CellKey;
+pub use key::{CellKey, KeyBounds};
 pub use mapper::{MapFilter, Mapper, MapperOptions, RemovalCounts};
 pub use matcher::{MatchOptions, MatchResult};
 pub use nalgebra;

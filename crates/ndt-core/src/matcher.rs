@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector2};
 
-use crate::cell::Gaussian;
+use crate::cell::{Gaussian, DEFAULT_SIGMA_FLOOR};
 use crate::degeneracy::{constrained_projector, unconstrained_directions};
 use crate::distributions::{DistOptions, Distributions};
 use crate::error::{check_bound, check_finite, NdtError, Result};
@@ -46,6 +46,12 @@ pub const AUTO_COARSEST_CELL: f64 = 0.64;
 pub struct MatchOptions {
     /// `k` of eq. (8) (> 0; 1 = no expansion).
     pub expansion: f64,
+    /// Smallest standard deviation [m] a cell's distribution is given before
+    /// the expansion (> 0): the scatter between two scans of one surface
+    /// (range noise, beam footprint, sampling). Default
+    /// [`DEFAULT_SIGMA_FLOOR`] (1 cm), chosen by measurement (see there);
+    /// lower it for a more precise sensor.
+    pub sigma_floor: f64,
     /// §IV-A(1): pair points whose own cell has no distribution with a nearby
     /// cell's (see [`crate::neighbor::nearest_in_rings`]).
     pub neighbor_search: bool,
@@ -95,6 +101,7 @@ impl Default for MatchOptions {
     fn default() -> Self {
         Self {
             expansion: 10.0,
+            sigma_floor: DEFAULT_SIGMA_FLOOR,
             neighbor_search: true,
             search_radius: 1,
             fuse_minority: true,
@@ -118,6 +125,7 @@ impl MatchOptions {
             check_bound(name, "a finite value > 0", value, 0.0, true)
         };
         positive("expansion", self.expansion)?;
+        positive("sigma_floor", self.sigma_floor)?;
         positive("translation_tolerance", self.translation_tolerance)?;
         positive("rotation_tolerance", self.rotation_tolerance)?;
         positive("max_step_cells", self.max_step_cells)?;
@@ -159,6 +167,7 @@ impl MatchOptions {
     fn dist_options(&self) -> DistOptions {
         DistOptions {
             expansion: self.expansion,
+            sigma_floor: self.sigma_floor,
             fuse_minority: self.fuse_minority,
         }
     }

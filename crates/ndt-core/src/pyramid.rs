@@ -7,7 +7,7 @@ use nalgebra::Vector2;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::cell::CellStats;
-use crate::key::CellKey;
+use crate::key::{CellKey, KeyBounds};
 
 /// Most levels a grid may have (fine level included).
 pub const MAX_LEVELS: usize = 12;
@@ -36,6 +36,9 @@ impl Level {
 #[derive(Debug, Clone)]
 pub struct Pyramid {
     levels: Vec<Level>,
+    /// A superset of the fine keys in use: grown by every insert, reset when
+    /// the fine level empties (removals do not shrink it).
+    bounds: Option<KeyBounds>,
 }
 
 /// The key of the level-`level` cell covering fine cell `key`: an arithmetic
@@ -57,7 +60,16 @@ impl Pyramid {
                 cells: FxHashMap::default(),
             })
             .collect();
-        Self { levels }
+        Self {
+            levels,
+            bounds: None,
+        }
+    }
+
+    /// A rectangle of fine keys holding every occupied fine cell (possibly
+    /// more), `None` when the fine level is empty.
+    pub fn bounds(&self) -> Option<KeyBounds> {
+        self.bounds
     }
 
     /// Number of levels (1 = the fine grid only).
@@ -115,6 +127,12 @@ impl Pyramid {
         }
         if let Some((k, stats)) = run {
             flush(k, &stats);
+        }
+        if let Some(added) = KeyBounds::of_keys(touched.iter().copied()) {
+            self.bounds = Some(match self.bounds {
+                Some(b) => b.including(added.min).including(added.max),
+                None => added,
+            });
         }
         self.refresh_parents(touched)
     }
@@ -175,6 +193,9 @@ impl Pyramid {
                 removed.push(key);
             }
         }
+        if self.levels[0].cells.is_empty() {
+            self.bounds = None;
+        }
         self.refresh_parents(removed)
     }
 }
@@ -184,6 +205,7 @@ impl Pyramid {
     /// each cell's centre) and each coarser level is summed from the one below.
     pub fn set_fine(&mut self, states: &[(CellKey, CellStats)]) {
         self.levels[0].cells = states.iter().copied().collect();
+        self.bounds = KeyBounds::of_keys(states.iter().map(|(k, _)| *k));
         for level in &mut self.levels[1..] {
             level.cells.clear();
         }

@@ -68,6 +68,13 @@ impl ScoreTerms {
         let e = d.x * cd0 + d.y * cd1;
         // eq. (1): one point's contribution.
         let s = (-0.5 * e).exp();
+        // A point so far out that its term underflows adds nothing (0 · ∞
+        // in the derivatives would be NaN with extreme options); an e of NaN
+        // (∞ − ∞ from a huge inverse covariance) likewise. For every other
+        // point this changes no bit: the skipped terms are exact zeros.
+        if s.is_nan() || s <= 0.0 {
+            return;
+        }
         self.score += s;
         if order == Order::Value {
             return;

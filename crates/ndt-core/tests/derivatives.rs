@@ -30,12 +30,13 @@ fn random_gaussian(rng: &mut StdRng) -> Gaussian {
     let mut s = CellStats::default();
     for _ in 0..6 {
         s.add_point(Vector2::new(
-            rng.random_range(-0.01..0.01),
-            rng.random_range(-0.01..0.01),
+            rng.random_range(-0.05..0.05),
+            rng.random_range(-0.05..0.05),
         ));
     }
+    // Spread above the 5 mm σ floor, so the inverses are anisotropic.
     let origin = Vector2::new(rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0));
-    Gaussian::from_stats(&s, origin, 0.02, rng.random_range(1.0..20.0)).unwrap()
+    Gaussian::from_stats(&s, origin, 0.005, rng.random_range(1.0..20.0)).unwrap()
 }
 
 #[test]

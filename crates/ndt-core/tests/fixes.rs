@@ -20,19 +20,20 @@ fn stats(points: &[[f64; 2]], origin: [f64; 2]) -> CellStats {
 
 #[test]
 fn expansion_multiplies_both_eigenvalues_and_keeps_eigenvectors() {
-    // A wall-like cell: spread along a 30° line, thin across.
+    // A wall-like cell of 20 cm: spread along a 30° line, thinner across
+    // (both above the 1 cm σ floor, so the regularisation leaves the shape alone).
     let pts: Vec<[f64; 2]> = (0..12)
         .map(|i| {
             // Each position along the line twice, once on either side of it.
-            let t = -0.008 + 0.0032 * f64::from(i / 2);
-            let n = if i % 2 == 0 { 0.002 } else { -0.002 };
+            let t = -0.08 + 0.032 * f64::from(i / 2);
+            let n = if i % 2 == 0 { 0.02 } else { -0.02 };
             let (s, c) = 30f64.to_radians().sin_cos();
             [t * c - n * s, t * s + n * c]
         })
         .collect();
     let s = stats(&pts, [0.0, 0.0]);
-    let g1 = Gaussian::from_stats(&s, Vector2::zeros(), 0.02, 1.0).unwrap();
-    let g10 = Gaussian::from_stats(&s, Vector2::zeros(), 0.02, 10.0).unwrap();
+    let g1 = Gaussian::from_stats(&s, Vector2::zeros(), 0.01, 1.0).unwrap();
+    let g10 = Gaussian::from_stats(&s, Vector2::zeros(), 0.01, 10.0).unwrap();
     let (a1, a2, v) = symmetric_eigen2(&g1.covariance());
     let (b1, b2, w) = symmetric_eigen2(&g10.covariance());
     assert!((b1 / a1 - 10.0).abs() < 1e-9, "{a1} {b1}");
@@ -47,7 +48,7 @@ fn expansion_multiplies_both_eigenvalues_and_keeps_eigenvectors() {
 fn small_eigenvalue_is_regularised() {
     // Collinear points: a singular covariance.
     let pts: Vec<[f64; 2]> = (0..5).map(|i| [0.004 * f64::from(i), 0.0]).collect();
-    let g = Gaussian::from_stats(&stats(&pts, [0.0, 0.0]), Vector2::zeros(), 0.02, 1.0).unwrap();
+    let g = Gaussian::from_stats(&stats(&pts, [0.0, 0.0]), Vector2::zeros(), 0.005, 1.0).unwrap();
     let (l1, l2, _) = symmetric_eigen2(&g.covariance());
     assert!(l2 >= 0.01 * l1 * (1.0 - 1e-12));
     assert!(l2 >= (0.005f64).powi(2) * (1.0 - 1e-12));
@@ -72,6 +73,7 @@ fn two_point_cell_gets_the_fused_distribution() {
         DistOptions {
             expansion: 1.0,
             fuse_minority: true,
+            sigma_floor: 0.005,
         },
     );
     let plain = Distributions::build(
@@ -81,6 +83,7 @@ fn two_point_cell_gets_the_fused_distribution() {
         DistOptions {
             expansion: 1.0,
             fuse_minority: false,
+            sigma_floor: 0.005,
         },
     );
     let key = CellKey { ix: 0, iy: 0 };
@@ -92,7 +95,7 @@ fn two_point_cell_gets_the_fused_distribution() {
     // It is eq. (7) of the summed sums of the 3×3 block: all six points.
     let all: Vec<[f64; 2]> = own.iter().chain(&right).chain(&up).copied().collect();
     let expect =
-        Gaussian::from_stats(&stats(&all, [0.0, 0.0]), Vector2::zeros(), cell, 1.0).unwrap();
+        Gaussian::from_stats(&stats(&all, [0.0, 0.0]), Vector2::zeros(), 0.005, 1.0).unwrap();
     assert!((g.mean - expect.mean).norm() < 1e-15);
     assert!((g.inverse - expect.inverse).norm() < 1e-6 * expect.inverse.norm());
     // The 1-point cell (0, 1) also fuses (its block holds all six points too).
@@ -114,6 +117,7 @@ fn neighbour_search_pairs_a_point_outside_every_cell() {
         DistOptions {
             expansion: 10.0,
             fuse_minority: true,
+            sigma_floor: 0.005,
         },
     );
     // A point two cells above the wall: its own cell is empty.

@@ -114,7 +114,7 @@ impl PyNdtGrid {
 
     /// Matches scan-frame points against the map from `guess`.
     #[pyo3(name = "match", signature = (
-        points, guess, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
+        points, guess, *, expansion = 10.0, sigma_floor = 0.01, neighbor_search = true, fuse_minority = true,
         pair_neighbors = false, search_radius = 1, max_iterations = 50, translation_tolerance = 1e-4,
         rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, rotation_search = 0.15, freeze_unconstrained = true,
         levels = None,
@@ -127,6 +127,7 @@ impl PyNdtGrid {
         points: &Bound<'_, PyAny>,
         guess: &Bound<'_, PyAny>,
         expansion: f64,
+        sigma_floor: f64,
         neighbor_search: bool,
         fuse_minority: bool,
         pair_neighbors: bool,
@@ -143,6 +144,7 @@ impl PyNdtGrid {
     ) -> PyResult<PyMatchResult> {
         let options = MatchOptions {
             expansion,
+            sigma_floor,
             neighbor_search,
             search_radius: count("search_radius", search_radius)?,
             fuse_minority,
@@ -174,7 +176,7 @@ impl PyNdtGrid {
 
     /// Score terms of eq. (1) at `pose` without solving.
     #[pyo3(signature = (
-        points, pose, *, expansion = 10.0, neighbor_search = true, fuse_minority = true,
+        points, pose, *, expansion = 10.0, sigma_floor = 0.01, neighbor_search = true, fuse_minority = true,
         pair_neighbors = false, search_radius = 1
     ))]
     #[allow(clippy::too_many_arguments)]
@@ -184,6 +186,7 @@ impl PyNdtGrid {
         points: &Bound<'py, PyAny>,
         pose: &Bound<'py, PyAny>,
         expansion: f64,
+        sigma_floor: f64,
         neighbor_search: bool,
         fuse_minority: bool,
         pair_neighbors: bool,
@@ -192,6 +195,7 @@ impl PyNdtGrid {
         let defaults = MatchOptions::default();
         let options = MatchOptions {
             expansion,
+            sigma_floor,
             neighbor_search,
             fuse_minority,
             pair_neighbors,
@@ -316,6 +320,7 @@ pub fn default_match_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let d = MatchOptions::default();
     let out = PyDict::new(py);
     out.set_item("expansion", d.expansion)?;
+    out.set_item("sigma_floor", d.sigma_floor)?;
     out.set_item("neighbor_search", d.neighbor_search)?;
     out.set_item("fuse_minority", d.fuse_minority)?;
     out.set_item("pair_neighbors", d.pair_neighbors)?;

@@ -90,6 +90,12 @@ impl PyOdometry {
     fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, Odometry>> {
         self.inner.lock().map_err(|_| poisoned())
     }
+
+    /// Runs `f` on the loop with the GIL released: waiting for another
+    /// thread's `step` must not stall every other Python thread.
+    fn with<T: Send>(&self, py: Python<'_>, f: impl FnOnce(&Odometry) -> T + Send) -> PyResult<T> {
+        py.detach(|| self.lock().map(|o| f(&o)))
+    }
 }
 
 #[pymethods]
@@ -99,7 +105,7 @@ impl PyOdometry {
         cell_size = 0.02, *, min_range = None, max_range = None, insert_distance = None,
         insert_angle = None, map_window = None, min_match_ratio = None, rotation_search = None,
         rotation_step = None, prior_gap_distance = None, prior_gap_angle = None,
-        expansion = None,
+        expansion = None, sigma_floor = None,
         neighbor_search = None, fuse_minority = None, search_radius = None,
         max_iterations = None, max_step_cells = None, max_step_rotation = None,
         levels = None, coarse_rotation_search = None, freeze_unconstrained = None,
@@ -120,6 +126,7 @@ impl PyOdometry {
         prior_gap_distance: Option<f64>,
         prior_gap_angle: Option<f64>,
         expansion: Option<f64>,
+        sigma_floor: Option<f64>,
         neighbor_search: Option<bool>,
         fuse_minority: Option<bool>,
         search_radius: Option<i64>,
@@ -144,6 +151,7 @@ impl PyOdometry {
             .map_or(d.map_window, |w| w as usize);
         let matcher = MatchOptions {
             expansion: expansion.unwrap_or(m.expansion),
+            sigma_floor: sigma_floor.unwrap_or(m.sigma_floor),
             neighbor_search: neighbor_search.unwrap_or(m.neighbor_search),
             fuse_minority: fuse_minority.unwrap_or(m.fuse_minority),
             search_radius: search_radius
@@ -219,40 +227,39 @@ impl PyOdometry {
     /// `(T, 3)` pose of every scan so far.
     #[getter]
     fn poses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let flat: Vec<f64> = {
-            let odo = self.lock()?;
-            odo.poses().iter().flat_map(|p| p.to_array()).collect()
-        };
+        let flat: Vec<f64> = self.with(py, |o| {
+            o.poses().iter().flat_map(|p| p.to_array()).collect()
+        })?;
         let t = flat.len() / 3;
         PyArray1::from_vec(py, flat).reshape([t, 3])
     }
 
     /// Scans added to the map so far.
     #[getter]
-    fn insertions(&self) -> PyResult<u64> {
-        Ok(self.lock()?.insertions())
+    fn insertions(&self, py: Python<'_>) -> PyResult<u64> {
+        self.with(py, Odometry::insertions)
     }
 
     /// Cells in the map now.
-    fn __len__(&self) -> PyResult<usize> {
-        Ok(self.lock()?.grid().len())
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.with(py, |o| o.grid().len())
     }
 
     /// A copy of the map.
     fn grid(&self, py: Python<'_>) -> PyResult<PyNdtGrid> {
-        let grid = py.detach(|| self.lock().map(|o| o.grid().clone()))?;
+        let grid = self.with(py, |o| o.grid().clone())?;
         Ok(PyNdtGrid::from(grid))
     }
 
     /// A copy of the mapper (grid and §V filter state) as of this call.
     fn mapper(&self, py: Python<'_>) -> PyResult<crate::mapper::PyMapper> {
-        let mapper = py.detach(|| self.lock().map(|o| o.mapper().clone()))?;
+        let mapper = self.with(py, |o| o.mapper().clone())?;
         crate::mapper::PyMapper::from_core(py, mapper)
     }
 
     /// The settings in force, as keyword arguments of the constructor.
     fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let c = *self.lock()?.config();
+        let c = self.with(py, |o| *o.config())?;
         config_dict(py, &c)
     }
 }
@@ -271,6 +278,7 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("prior_gap_distance", c.prior_gap_distance)?;
     out.set_item("prior_gap_angle", c.prior_gap_angle)?;
     out.set_item("expansion", c.matcher.expansion)?;
+    out.set_item("sigma_floor", c.matcher.sigma_floor)?;
     out.set_item("neighbor_search", c.matcher.neighbor_search)?;
     out.set_item("fuse_minority", c.matcher.fuse_minority)?;
     out.set_item("search_radius", c.matcher.search_radius)?;

@@ -7,7 +7,7 @@
 
 use nalgebra::Vector2;
 
-use crate::filter::raywalk::walk_cells;
+use crate::filter::raywalk::walk_cells_in;
 use crate::grid::NdtGrid;
 use crate::key::CellKey;
 
@@ -36,7 +36,7 @@ pub fn former_cell_short_of(
         hit - ray * (window / range)
     };
     let mut found = false;
-    walk_cells(start, hit, cell_size, |key, _, _| {
+    walk_cells_in(start, hit, cell_size, grid.key_bounds(), |key, _, _| {
         if key != hit_key && grid.stats(key).is_some() {
             found = true;
         }

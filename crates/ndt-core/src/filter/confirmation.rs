@@ -22,7 +22,7 @@ use rustc_hash::FxHashMap;
 
 use crate::filter::areas::Area;
 use crate::filter::observation::CellTable;
-use crate::filter::raywalk::walk_cells;
+use crate::filter::raywalk::walk_cells_in;
 use crate::filter::Beam;
 use crate::grid::NdtGrid;
 use crate::key::CellKey;
@@ -103,30 +103,36 @@ pub fn passed_cells(
     let dir = ray / range;
     let reach = range - margin;
     let cell_size = grid.cell_size();
-    walk_cells(sensor, sensor + dir * reach, cell_size, |key, _, _| {
-        let Some(stats) = grid.stats(key) else {
-            return true;
-        };
-        if stats.count == 0 {
-            return true;
-        }
-        let mean = key.center(cell_size) + stats.sum / stats.count as f64;
-        let rel = mean - sensor;
-        let along = rel.dot(&dir);
-        let side = dir.x * rel.y - dir.y * rel.x;
-        if along <= 0.0 || along >= reach || side.abs() > clearing.pass_radius {
-            return true;
-        }
-        let small = table.get(&key).is_some_and(|c| c.is_small());
-        if !small || Area::of(rel.norm(), clearing.reliable_range) == Area::Reliable {
-            out.push(Pass {
-                key,
-                small,
-                left: side > 0.0,
-            });
-        }
-        true
-    });
+    walk_cells_in(
+        sensor,
+        sensor + dir * reach,
+        cell_size,
+        grid.key_bounds(),
+        |key, _, _| {
+            let Some(stats) = grid.stats(key) else {
+                return true;
+            };
+            if stats.count == 0 {
+                return true;
+            }
+            let mean = key.center(cell_size) + stats.sum / stats.count as f64;
+            let rel = mean - sensor;
+            let along = rel.dot(&dir);
+            let side = dir.x * rel.y - dir.y * rel.x;
+            if along <= 0.0 || along >= reach || side.abs() > clearing.pass_radius {
+                return true;
+            }
+            let small = table.get(&key).is_some_and(|c| c.is_small());
+            if !small || Area::of(rel.norm(), clearing.reliable_range) == Area::Reliable {
+                out.push(Pass {
+                    key,
+                    small,
+                    left: side > 0.0,
+                });
+            }
+            true
+        },
+    );
 }
 
 /// §V step d for a whole scan: the cells to remove given every beam's

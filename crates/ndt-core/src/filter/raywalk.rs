@@ -4,7 +4,7 @@
 
 use nalgebra::Vector2;
 
-use crate::key::CellKey;
+use crate::key::{CellKey, KeyBounds};
 
 /// Visits, in order from `from` to `to` (map frame [m]), every cell of size
 /// `cell_size` [m] that the segment crosses, calling `visit(key, t_in, t_out)`
@@ -17,6 +17,79 @@ pub fn walk_cells(
     from: Vector2<f64>,
     to: Vector2<f64>,
     cell_size: f64,
+    visit: impl FnMut(CellKey, f64, f64) -> bool,
+) {
+    walk_until(from, to, cell_size, f64::INFINITY, visit);
+}
+
+/// [`walk_cells`] restricted to the cells of `region` (see
+/// [`crate::NdtGrid::key_bounds`]) and a margin of one cell: the part of the
+/// segment outside is not walked. Callers that only look for occupied cells
+/// see the same cells, at a cost bounded by the map's extent instead of the
+/// beam's length (a driver's 10⁶ m range would otherwise walk 5·10⁷ cells of
+/// 2 cm). When the segment starts inside, the walk is [`walk_cells`]'s, cut
+/// short where it leaves; a segment starting outside is walked from where it
+/// enters (distances passed to `visit` are then from that point; where the
+/// segment runs exactly through a cell corner, the walk from there may step
+/// into the other of the two cells touching it, as a walk from any other
+/// start point may). `None` (an empty grid) walks nothing.
+pub fn walk_cells_in(
+    from: Vector2<f64>,
+    to: Vector2<f64>,
+    cell_size: f64,
+    region: Option<KeyBounds>,
+    visit: impl FnMut(CellKey, f64, f64) -> bool,
+) {
+    let Some(region) = region else {
+        return;
+    };
+    // The region with a one-cell margin, in metres.
+    let lo = [
+        (f64::from(region.min.ix) - 1.0) * cell_size,
+        (f64::from(region.min.iy) - 1.0) * cell_size,
+    ];
+    let hi = [
+        (f64::from(region.max.ix) + 2.0) * cell_size,
+        (f64::from(region.max.iy) + 2.0) * cell_size,
+    ];
+    // Liang–Barsky: the parameter interval [t0, t1] of `from + t (to − from)`
+    // inside the rectangle.
+    let delta = to - from;
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for axis in 0..2 {
+        let (o, d) = (from[axis], delta[axis]);
+        if d == 0.0 {
+            if !(lo[axis] <= o && o <= hi[axis]) {
+                return;
+            }
+        } else {
+            let (a, b) = ((lo[axis] - o) / d, (hi[axis] - o) / d);
+            t0 = t0.max(a.min(b));
+            t1 = t1.min(a.max(b));
+        }
+    }
+    // Also rejects NaN.
+    if t0
+        .partial_cmp(&t1)
+        .is_none_or(|o| o == std::cmp::Ordering::Greater)
+    {
+        return;
+    }
+    let length = delta.norm();
+    if t0 > 0.0 {
+        walk_until(from + delta * t0, to, cell_size, (t1 - t0) * length, visit);
+    } else {
+        walk_until(from, to, cell_size, t1 * length, visit);
+    }
+}
+
+/// [`walk_cells`], stopping before the first cell entered farther than
+/// `stop` [m] from `from`.
+fn walk_until(
+    from: Vector2<f64>,
+    to: Vector2<f64>,
+    cell_size: f64,
+    stop: f64,
     mut visit: impl FnMut(CellKey, f64, f64) -> bool,
 ) {
     let inv = 1.0 / cell_size;
@@ -52,6 +125,9 @@ pub fn walk_cells(
         + 2;
     let mut t_in = 0.0;
     for _ in 0..budget {
+        if t_in > stop {
+            return;
+        }
         let t_out = next_x.min(next_y).min(length);
         // Walk until the end point's own cell, even when the segment only
         // touches it (an end on a cell boundary).
@@ -141,5 +217,63 @@ mod tests {
         assert!(walk([f64::NAN, 0.0], [1.0, 0.0], 0.1).is_empty());
         // Along an axis: one cell per 0.1 m.
         assert_eq!(walk([0.05, 0.05], [0.95, 0.05], 0.1).len(), 10);
+    }
+
+    #[test]
+    fn the_walk_in_a_region_sees_the_same_cells_there_and_skips_the_rest() {
+        let cell = 0.02;
+        let inv = 1.0 / cell;
+        let region = KeyBounds::of(CellKey::of(Vector2::new(-1.0, -0.5), inv).unwrap())
+            .including(CellKey::of(Vector2::new(1.0, 0.7), inv).unwrap());
+        let inside = |k: &CellKey| {
+            (region.min.ix..=region.max.ix).contains(&k.ix)
+                && (region.min.iy..=region.max.iy).contains(&k.iy)
+        };
+        let cases = [
+            // Inside to inside, inside to far outside, outside through, outside
+            // missing it, and a 10^6 m beam.
+            ([0.011, 0.013], [0.91, 0.35]),
+            ([0.3, 0.2], [40.0, -17.0]),
+            ([-30.0, 0.1], [30.0, 0.33]),
+            ([-30.0, 5.0], [30.0, 5.0]),
+            ([0.05, 0.05], [1.0e6, 3.0e5]),
+        ];
+        for (a, b) in cases {
+            let (pa, pb) = (Vector2::new(a[0], a[1]), Vector2::new(b[0], b[1]));
+            let mut all = Vec::new();
+            if (pb - pa).norm() < 1e3 {
+                walk_cells(pa, pb, cell, |k, _, _| {
+                    all.push(k);
+                    true
+                });
+            }
+            let mut clipped = Vec::new();
+            walk_cells_in(pa, pb, cell, Some(region), |k, _, _| {
+                clipped.push(k);
+                true
+            });
+            // Never more than the region's extent (plus its margin).
+            let span = (region.max.ix - region.min.ix + region.max.iy - region.min.iy) as usize;
+            assert!(clipped.len() <= span + 8, "{} cells", clipped.len());
+            let want: Vec<CellKey> = all.into_iter().filter(|k| inside(k)).collect();
+            let got: Vec<CellKey> = clipped.into_iter().filter(|k| inside(k)).collect();
+            if (pb - pa).norm() < 1e3 {
+                assert_eq!(got, want, "{a:?} -> {b:?}");
+            } else {
+                assert!(!got.is_empty());
+            }
+        }
+        let mut n = 0;
+        walk_cells_in(
+            Vector2::zeros(),
+            Vector2::new(1.0, 0.0),
+            cell,
+            None,
+            |_, _, _| {
+                n += 1;
+                true
+            },
+        );
+        assert_eq!(n, 0);
     }
 }

@@ -59,6 +59,12 @@ impl MapFilter {
         self.counts
     }
 
+    /// Number of cells the filter keeps a record of (each at most once; the
+    /// records of cells that left the grid go at the next periodic check).
+    pub fn tracked_cells(&self) -> usize {
+        self.table.len()
+    }
+
     /// The filter's record of cell `key`, if a filtered scan hit it.
     pub fn cell_info(&self, key: CellKey) -> Option<&CellInfo> {
         self.table.get(&key)

@@ -35,7 +35,8 @@ impl MapFilter {
     /// `ranges` [m] and `angles` [rad, sensor frame] hold one value per beam,
     /// in beam order (the order clustering follows). Beams whose range is 0,
     /// NaN, infinite, below `min_range` or at or above `max_range` are
-    /// skipped. With `outlier_filter` off every other beam is stored.
+    /// skipped. With `outlier_filter` off every other beam is stored. A scan
+    /// without a valid beam changes nothing and is not counted.
     ///
     /// Errors (and changes nothing) when the lengths differ, an angle or the
     /// pose is not finite, or a hit's cell index would overflow.
@@ -47,6 +48,13 @@ impl MapFilter {
         pose: Pose2,
     ) -> Result<()> {
         let beams = self.valid_beams(grid, ranges, angles, pose)?;
+        // A scan with no valid beam (a blinded sensor, a driver sending only
+        // NaN, 0 or inf) observes nothing: it changes neither the map nor the
+        // filter, not even the scan counter, so a burst of them cannot age
+        // young cells into step c's deletion.
+        if beams.is_empty() {
+            return Ok(());
+        }
         let scan = self.scans + 1;
         let o = self.options;
         if !o.outlier_filter {

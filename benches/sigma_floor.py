@@ -1,0 +1,76 @@
+"""The sigma-floor sweep behind ``MatchOptions::sigma_floor`` (BENCHMARK.md, convergence study).
+
+Success of the default 2 cm ``match`` with each floor on the sets of
+``benches/convergence.py``: its real SICK pairs, the held-out pairs half-way between
+them, the URG-04LX pairs (peer-consensus reference) and the simulated pairs, with
+the same starts as that benchmark (``--seed``).
+
+Run: ``python benches/sigma_floor.py [--pairs 30] [--starts 8]``; prints a Markdown table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import convergence as cv
+
+import ndtgrid
+from ndtgrid.evaluation import pose_error
+
+FLOORS = (0.005, 0.01, 0.015, 0.02, 0.03)
+
+
+def success(pairs: list[cv.Pair], starts: list[np.ndarray], floor: float) -> float:
+    """Percentage of starts that end within the pair's tolerance."""
+    ok = 0
+    for pair, deltas in zip(pairs, starts):
+        grid = ndtgrid.NdtGrid(0.02, levels=6)
+        grid.insert(pair.target, np.zeros(3))
+        for d in deltas:
+            et, er = pose_error(
+                grid.match(pair.source, pair.truth + d, sigma_floor=floor).pose, pair.truth
+            )
+            ok += et < pair.tol[0] and er < pair.tol[1]
+    return 100.0 * ok / max(1, sum(len(s) for s in starts))
+
+
+def main() -> None:
+    """Run the sweep."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--pairs", type=int, default=30, help="pairs per real log")
+    ap.add_argument("--starts", type=int, default=8, help="starts per pair and set")
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args()
+    sets = {
+        "SICK pairs": list(cv.real_pairs(args.pairs)),
+        "held-out SICK pairs": list(cv.real_pairs(args.pairs, held_out=True)),
+        "URG-04LX pairs": list(cv.urg_pairs(40)),
+        "simulated pairs": list(cv.sim_pairs(8, args.seed)),
+    }
+    starts = {}
+    for name, pairs in sets.items():
+        rng = np.random.default_rng(args.seed)  # as convergence.py draws them
+        wide = [cv.starts(rng, args.starts, 0.4, 10.0) for _ in pairs]
+        local = [cv.starts(rng, args.starts, 0.05, 2.0) for _ in pairs]
+        starts[name] = (local, wide)
+    names = [n for n in sets if sets[n]]
+    print("| σ floor | " + " | ".join(f"{n} ({len(sets[n])})" for n in names) + " |")
+    print("|---|" + "---|" * len(names))
+    for floor in FLOORS:
+        cells = []
+        for n in names:
+            local, wide = starts[n]
+            cells.append(
+                f"{success(sets[n], local, floor):.1f} / {success(sets[n], wide, floor):.1f} %"
+            )
+        print(f"| {1e3 * floor:.0f} mm | " + " | ".join(cells) + " |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
