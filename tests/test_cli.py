@@ -57,7 +57,7 @@ def test_map_writes_every_output(tmp_path: Path, capsys: pytest.CaptureFixture[s
     out = tmp_path / "out"
     assert main(["map", str(tmp_path / "room.log"), "--out", str(out), "--quiet"]) == 0
     assert f"{N_SCANS} scans in" in capsys.readouterr().out
-    for name in ("map.png", "map.pgm", "map.yaml", "trajectory.tum", "map.npz"):
+    for name in ("map.png", "map.pgm", "map.yaml", "trajectory.tum", "map.ndtgrid"):
         assert (out / name).stat().st_size > 0, name
     times, poses = read_tum(out / "trajectory.tum")
     np.testing.assert_allclose(times, 10 + 0.1 * np.arange(N_SCANS), atol=1e-6)
@@ -70,7 +70,8 @@ def test_map_writes_every_output(tmp_path: Path, capsys: pytest.CaptureFixture[s
     image = read_ros_map(out / "map.yaml")
     assert image.resolution == 0.05
     assert (image.cells == 100).sum() > 300 and (image.cells == 0).sum() > 1000
-    grid = load_map(out / "map.npz")
+    assert (out / "map.ndtgrid").read_bytes()[:8] == b"NDTGRID\x00"
+    grid = load_map(out / "map.ndtgrid")
     assert grid.cell_size == 0.02 and len(grid) > 500
     assert (out / "map.png").read_bytes()[:4] == b"\x89PNG"
 

@@ -38,7 +38,7 @@ def test_demo_maps_the_simulated_room(tmp_path: Path, capsys: object) -> None:
 
     assert main(["demo", "--out", str(tmp_path), "--quiet"]) == 0
     out = capsys.readouterr().out  # type: ignore[attr-defined]
-    for name in ("map.png", "map.pgm", "map.yaml", "trajectory.tum", "map.npz"):
+    for name in ("map.png", "map.pgm", "map.yaml", "trajectory.tum", "map.ndtgrid"):
         assert (tmp_path / name).stat().st_size > 0, name
     m = re.search(
         r"pose error against the truth: (\S+) cm RMS, (\S+) cm max "

@@ -20,6 +20,7 @@ from ndtgrid.export import (
     write_ros_map,
     write_tum,
 )
+from ndtgrid.export.map_file import MAGIC, NPZ_FORMAT, NPZ_VERSION
 
 from ._room import scan as room_scan
 
@@ -129,8 +130,10 @@ def test_png_is_written(tmp_path: Path) -> None:
 
 def test_map_file_loads_back_identical(tmp_path: Path) -> None:
     grid, _ = room_map(0.05)
-    save_map(tmp_path / "map.npz", grid)
-    back = load_map(tmp_path / "map.npz")
+    save_map(tmp_path / "map.ndtgrid", grid)
+    assert (tmp_path / "map.ndtgrid").read_bytes() == grid.to_bytes()
+    assert (tmp_path / "map.ndtgrid").read_bytes()[:8] == MAGIC
+    back = load_map(tmp_path / "map.ndtgrid")
     assert back.cell_size == grid.cell_size and len(back) == len(grid)
     for a, b in zip(grid.cell_states(), back.cell_states()):
         np.testing.assert_array_equal(a, b)
@@ -140,11 +143,35 @@ def test_map_file_loads_back_identical(tmp_path: Path) -> None:
     assert ra.score == rb.score
 
 
+def test_map_file_reads_the_npz_of_earlier_releases(tmp_path: Path) -> None:
+    grid, _ = room_map(0.05)
+    indices, counts, sums, scatters = grid.cell_states()
+    # Exactly what save_map wrote before the ndtgrid format.
+    np.savez_compressed(
+        tmp_path / "old.npz",
+        format=np.array(NPZ_FORMAT),
+        version=np.array(NPZ_VERSION),
+        cell_size=np.array(grid.cell_size),
+        indices=indices,
+        counts=counts,
+        sums=sums,
+        scatters=scatters,
+    )
+    back = load_map(tmp_path / "old.npz")
+    assert back.to_bytes() == grid.to_bytes()
+
+
 def test_map_file_errors_name_the_file(tmp_path: Path) -> None:
     other = tmp_path / "other.npz"
     np.savez(other, x=np.zeros(3))
     with pytest.raises(ValueError, match=rf"^{other}: expected an ndtgrid-cells map file"):
         load_map(other)
+    text = tmp_path / "notes.txt"
+    text.write_text("not a map")
+    with pytest.raises(ValueError, match=rf"^{text}: not an ndtgrid file"):
+        load_map(text)
+    with pytest.raises(FileNotFoundError, match=r"missing\.ndtgrid"):
+        load_map(tmp_path / "missing.ndtgrid")
     grid, _ = room_map(0.05)
     idx, counts, sums, scatters = grid.cell_states()
     counts[3] = 0

@@ -162,5 +162,5 @@ def test_cli_maps_a_bag_and_drops_readings_beyond_range_max(tmp_path: Path) -> N
     # would put points far outside it).
     from ndtgrid.export import load_map
 
-    centres, _ = load_map(out / "map.npz").cells()
+    centres, _ = load_map(out / "map.ndtgrid").cells()
     assert np.abs(centres[:, 0]).max() < 3.1 and np.abs(centres[:, 1]).max() < 2.1

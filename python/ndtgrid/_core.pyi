@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import os
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
+#: The version of the ndtgrid file format this build writes (and the only one it reads).
+FORMAT_VERSION: int
 
 ArrayLike = npt.ArrayLike
 F64Array = npt.NDArray[np.float64]
@@ -322,6 +325,84 @@ class NdtGrid:
         scatters : ndarray, shape (K, 2, 2)
             ``S = sum x x^T`` [m^2].
         """
+    def to_bytes(self) -> bytes:
+        """The grid as the bytes of a grid file (exactly what :meth:`save` writes).
+
+        Equal grids give equal bytes. Pickling (and :mod:`copy`) uses these bytes.
+
+        Returns
+        -------
+        bytes
+            Header (magic ``NDTGRID\\0``, kind, format version, payload length,
+            CRC-32) and payload (cell size, pyramid levels, every cell's exact
+            state).
+        """
+    @classmethod
+    def from_bytes(cls, data: bytes) -> NdtGrid:
+        """The grid of a grid file's bytes (see :meth:`to_bytes`).
+
+        Parameters
+        ----------
+        data : bytes
+            The bytes of a grid file.
+
+        Returns
+        -------
+        NdtGrid
+            The saved grid, bit for bit: equal :meth:`cell_states`, cell size and
+            levels, and so equal :meth:`match` results.
+
+        Raises
+        ------
+        ValueError
+            If the bytes are not an ndtgrid file, are a mapper file, have an
+            unsupported format version, are truncated or longer than their header
+            says, fail the checksum, or hold an invalid payload; the message says
+            which.
+        """
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Save the grid to a file, atomically.
+
+        The bytes of :meth:`to_bytes` go to a temporary file in the same directory,
+        which is synced to disk and renamed over ``path``: the file is always either
+        the old one or the new one, whole. The GIL is released while writing.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file to write (``.ndtgrid`` by convention; replaced if it exists).
+
+        Raises
+        ------
+        OSError
+            If the file cannot be written (e.g. ``FileNotFoundError`` for a missing
+            directory); the message names the file. ``path`` is then untouched and no
+            temporary file is left.
+        """
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> NdtGrid:
+        """Load a grid saved by :meth:`save`.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            A grid file.
+
+        Returns
+        -------
+        NdtGrid
+            The saved grid, bit for bit (see :meth:`from_bytes`).
+
+        Raises
+        ------
+        OSError
+            If the file cannot be read (``FileNotFoundError``, ``IsADirectoryError``,
+            ...); the exception's ``filename`` is ``path``.
+        ValueError
+            If the file is not a valid grid file (see :meth:`from_bytes`); the message
+            starts with ``path``.
+        """
+    def __reduce__(self) -> tuple[Callable[[bytes], NdtGrid], tuple[bytes]]: ...
 
 class MapperOptions:
     """Options of :class:`Mapper`: the elimination of false detections of §V; frozen.
@@ -654,6 +735,62 @@ class Mapper:
         int
             Cells deleted.
         """
+    def to_bytes(self) -> bytes:
+        """The mapper as the bytes of a mapper file (exactly what :meth:`save` writes).
+
+        A mapper file holds the grid and the whole state of the §V filter: options,
+        per-cell observation records, scan counter, removal counters. Equal mappers
+        give equal bytes. Pickling (and :mod:`copy`) uses these bytes; the copy has a
+        grid of its own.
+        """
+    @classmethod
+    def from_bytes(cls, data: bytes) -> Mapper:
+        """The mapper of a mapper file's bytes (see :meth:`to_bytes`).
+
+        Parameters
+        ----------
+        data : bytes
+            The bytes of a mapper file.
+
+        Returns
+        -------
+        Mapper
+            The saved mapper: inserting the same scans into it and into the saved one
+            gives the same maps, bit for bit.
+
+        Raises
+        ------
+        ValueError
+            If the bytes are not an ndtgrid file, are a grid file, have an
+            unsupported format version, are truncated or longer than their header
+            says, fail the checksum, or hold an invalid payload (options, cells or
+            filter records); the message says which.
+        """
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Save the mapper (grid and filter state) to a file, atomically.
+
+        See :meth:`NdtGrid.save`: temporary file beside ``path``, synced, renamed over
+        it; the GIL is released while writing.
+
+        Raises
+        ------
+        OSError
+            If the file cannot be written; the message names the file. ``path`` is then
+            untouched and no temporary file is left.
+        """
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> Mapper:
+        """Load a mapper saved by :meth:`save`; it goes on exactly as the saved one.
+
+        Raises
+        ------
+        OSError
+            If the file cannot be read; the exception's ``filename`` is ``path``.
+        ValueError
+            If the file is not a valid mapper file (see :meth:`from_bytes`); the
+            message starts with ``path``.
+        """
+    def __reduce__(self) -> tuple[Callable[[bytes], Mapper], tuple[bytes]]: ...
 
 def default_mapper_options() -> dict[str, Any]:
     """The core's defaults for :class:`MapperOptions`."""

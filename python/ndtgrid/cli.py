@@ -2,9 +2,9 @@
 
 ``ndtgrid map LOG --out DIR``
     Run :class:`ndtgrid.Odometry` over a log and write ``map.png``, a ROS ``map_server`` map
-    (``map.pgm`` + ``map.yaml``), ``trajectory.tum`` and ``map.npz`` (the map's cells; it
-    loads back identical with :func:`ndtgrid.export.load_map` -- a stopgap until the
-    versioned, checksummed map format of a later issue).
+    (``map.pgm`` + ``map.yaml``), ``trajectory.tum`` and ``map.ndtgrid`` (the map itself
+    in the versioned, checksummed ndtgrid format; it loads back identical with
+    :meth:`ndtgrid.NdtGrid.load` or :func:`ndtgrid.export.load_map`).
 ``ndtgrid eval --estimate traj.tum --reference REF``
     The relation metric of Kümmerle et al. (2009) on consecutive reference poses.
 
@@ -55,7 +55,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     m = sub.add_parser(
         "map",
-        help="map a real log: map.png, map.pgm + map.yaml, trajectory.tum, map.npz",
+        help="map a real log: map.png, map.pgm + map.yaml, trajectory.tum, map.ndtgrid",
         description="Run the scan-to-map odometry over a log and write the map and trajectory.",
     )
     m.add_argument("log", metavar="LOG", help="the log file (or ROS 2 bag directory)")
@@ -148,7 +148,7 @@ def map_scans(
 ) -> tuple[Odometry, float] | None:
     """Run :class:`~ndtgrid.Odometry` over ``scans`` and write the map files to ``out``.
 
-    Writes ``map.png``, ``map.pgm`` + ``map.yaml``, ``trajectory.tum`` and ``map.npz``.
+    Writes ``map.png``, ``map.pgm`` + ``map.yaml``, ``trajectory.tum`` and ``map.ndtgrid``.
     Returns the odometry and the seconds it took, or ``None`` when there was no scan.
     """
     from ndtgrid import NdtGrid, Odometry
@@ -182,7 +182,7 @@ def map_scans(
     if np.any(np.diff(stamps) <= 0):  # repeated or unordered stamps: fall back to indices
         stamps = np.arange(len(times), dtype=np.float64)
     write_tum(out / "trajectory.tum", stamps, poses)
-    save_map(out / "map.npz", full)
+    save_map(out / "map.ndtgrid", full)
     centres, _ = full.cells()
     image = occupancy_image(free, centres)
     write_ros_map(out / "map.yaml", image)
@@ -190,7 +190,7 @@ def map_scans(
     print(
         f"{poses.shape[0]} scans in {elapsed:.1f} s ({1e3 * elapsed / poses.shape[0]:.2f} ms "
         f"per scan), {odo.insertions} added to the map, {len(full)} cells; wrote "
-        f"map.png, map.pgm, map.yaml, trajectory.tum, map.npz to {out}"
+        f"map.png, map.pgm, map.yaml, trajectory.tum, map.ndtgrid to {out}"
     )
     return odo, elapsed
 

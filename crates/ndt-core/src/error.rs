@@ -71,6 +71,110 @@ pub enum NdtError {
         /// What is wrong with it, in words.
         reason: &'static str,
     },
+    /// A saved filter record (see [`crate::persist`]) that no filter state
+    /// can hold.
+    #[error("filter: record {index} {reason}")]
+    InvalidRecord {
+        /// Position of the record in the file (records are sorted by key).
+        index: usize,
+        /// What is wrong with it, in words.
+        reason: &'static str,
+    },
+    /// A saved counter beyond what any real map reaches (see [`crate::persist`]).
+    #[error("{name}: {value} is beyond the limit of {limit} of a saved map")]
+    InvalidCounter {
+        /// The counter's name.
+        name: &'static str,
+        /// Its saved value.
+        value: u64,
+        /// The largest admissible value.
+        limit: u64,
+    },
+    /// Bytes that do not start with the magic bytes of an ndtgrid file.
+    #[error("not an ndtgrid file (it does not start with the magic bytes \"NDTGRID\\0\")")]
+    NotNdtFile,
+    /// An ndtgrid file of the other kind (a mapper file loaded as a grid or
+    /// the other way round), or of an unknown kind.
+    #[error("wrong kind of ndtgrid file: expected a {expected} file, got {found}")]
+    WrongKind {
+        /// The kind asked for: `"grid"` or `"mapper"`.
+        expected: &'static str,
+        /// The kind found, in words (`"a mapper file"`, `"an unknown kind …"`).
+        found: String,
+    },
+    /// A file format version this build cannot read.
+    #[error("unsupported ndtgrid file version {found}: this build reads version {supported}")]
+    UnsupportedVersion {
+        /// The version in the file.
+        found: u32,
+        /// The version this build reads (and writes).
+        supported: u32,
+    },
+    /// Fewer bytes than the header says the file has.
+    #[error("truncated ndtgrid file: expected {expected} bytes, got {got}")]
+    Truncated {
+        /// The length the file must have (at least the header's, while the
+        /// header itself is incomplete).
+        expected: u64,
+        /// The length it has.
+        got: u64,
+    },
+    /// More bytes than the header says the file has.
+    #[error(
+        "ndtgrid file has {} unexpected bytes after its payload: expected {expected} bytes, \
+         got {got}",
+        .got - .expected
+    )]
+    TrailingBytes {
+        /// The length the file must have.
+        expected: u64,
+        /// The length it has (more).
+        got: u64,
+    },
+    /// The CRC-32 of the header and payload differs from the stored one.
+    #[error(
+        "corrupt ndtgrid file: checksum mismatch (stored {stored:#010x}, computed {computed:#010x})"
+    )]
+    ChecksumMismatch {
+        /// The CRC-32 in the header.
+        stored: u32,
+        /// The CRC-32 of the bytes read.
+        computed: u32,
+    },
+    /// A payload that passes the checksum but cannot be decoded (written by
+    /// a faulty writer).
+    #[error("corrupt ndtgrid file: cannot decode the payload: {reason}")]
+    Decode {
+        /// What the decoder found, in words.
+        reason: String,
+    },
+    /// The map could not be encoded (not expected to happen: reported
+    /// rather than panicking).
+    #[error("cannot encode the map: {reason}")]
+    Encode {
+        /// What the encoder said.
+        reason: String,
+    },
+    /// Reading or writing a file failed.
+    #[error("{path}: cannot {action}: {message}")]
+    Io {
+        /// The file, as given.
+        path: String,
+        /// What was being done (`"read the file"`, `"write the file"`, …).
+        action: &'static str,
+        /// The operating system's error number, when there is one.
+        errno: Option<i32>,
+        /// The error's description (without the error number).
+        message: String,
+    },
+    /// An error about the content of the file `path`.
+    #[error("{path}: {error}")]
+    InFile {
+        /// The file, as given.
+        path: String,
+        /// What is wrong with its content.
+        error: Box<NdtError>,
+    },
     /// An output that would be larger than the stated limit.
     #[error("{what}: {size} would exceed the limit of {limit}")]
     TooLarge {

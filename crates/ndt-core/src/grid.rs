@@ -15,6 +15,8 @@ use crate::se2::Pose2;
 
 mod edit;
 
+pub use edit::MAX_CELL_COUNT;
+
 /// How many prepared distribution sets (one per pyramid level and distinct
 /// expansion/fusion setting) a grid keeps between calls.
 const PREPARED_CAPACITY: usize = 24;

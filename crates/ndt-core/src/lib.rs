@@ -11,7 +11,9 @@
 //!   of §IV-A (neighbour search, expansion by `k` of eq. 8, minority fusion);
 //! - [`Mapper`] / [`MapFilter`]: the elimination of false detections of §V
 //!   (sub-grid objects, wall speckle, moved objects) in front of the grid,
-//!   one step per file under [`filter`].
+//!   one step per file under [`filter`];
+//! - [`persist`]: `save` / `load` / `to_bytes` / `from_bytes` of grids and
+//!   mappers in a versioned, checksummed file.
 //!
 //! Units: metres and radians. Poses are `T_map_scan` (see [`Pose2`]).
 #![deny(missing_docs)]
@@ -30,6 +32,7 @@ pub mod mapper;
 pub mod matcher;
 pub mod neighbor;
 pub mod odometry;
+pub mod persist;
 pub mod pyramid;
 pub mod ranges;
 pub mod score;

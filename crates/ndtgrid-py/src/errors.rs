@@ -1,13 +1,25 @@
 //! The one place where core errors become Python exceptions.
 
 use ndt_core::NdtError;
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
 use pyo3::PyErr;
 
-/// Every [`NdtError`] is bad input: a `ValueError` carrying the core's message,
-/// which names the argument, what was expected and what came.
+/// Every [`NdtError`] but a failed file operation is bad input: a
+/// `ValueError` carrying the core's message, which names the argument (or
+/// the file), what was expected and what came. A failed file operation is
+/// an `OSError` with the error number, so that Python picks the subclass
+/// (`FileNotFoundError`, `IsADirectoryError`, ...), and the file name.
 pub fn to_py(err: NdtError) -> PyErr {
-    PyValueError::new_err(err.to_string())
+    match err {
+        NdtError::Io {
+            path,
+            action,
+            errno: Some(errno),
+            message,
+        } => PyOSError::new_err((errno, format!("cannot {action}: {message}"), path)),
+        NdtError::Io { .. } => PyOSError::new_err(err.to_string()),
+        other => PyValueError::new_err(other.to_string()),
+    }
 }
 
 /// A lock left poisoned by an internal panic: the map may be inconsistent, so

@@ -5,12 +5,13 @@
 //! The lock is reference counted so that an `ndtgrid.Mapper` and the
 //! `NdtGrid` it hands out (`mapper.grid`) are one and the same map.
 
+use std::path::PathBuf;
 use std::sync::{Arc, RwLock};
 
 use ndt_core::{MatchOptions, NdtGrid, Pose2};
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBytes, PyDict, PyType};
 
 use crate::convert::{count, mat3, points, pose, rows, vec3};
 use crate::errors::{poisoned, to_py};
@@ -268,7 +269,45 @@ impl PyNdtGrid {
     ) -> PyResult<Self> {
         crate::state::from_arrays(cell_size, indices, counts, sums, scatters).map(Self::from)
     }
+
+    /// The bytes of a grid file (what `save` writes).
+    fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let bytes = self.read(py, NdtGrid::to_bytes)?.map_err(to_py)?;
+        Ok(PyBytes::new(py, &bytes))
+    }
+
+    /// The grid of a grid file's bytes.
+    #[classmethod]
+    fn from_bytes(_cls: &Bound<'_, PyType>, py: Python<'_>, data: &[u8]) -> PyResult<Self> {
+        py.detach(|| NdtGrid::from_bytes(data))
+            .map(Self::from)
+            .map_err(to_py)
+    }
+
+    /// Saves the grid to a file, atomically.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let bytes = self.read(py, NdtGrid::to_bytes)?.map_err(to_py)?;
+        py.detach(|| ndt_core::persist::write_atomic(&path, &bytes))
+            .map_err(to_py)
+    }
+
+    /// Loads a grid saved by `save`.
+    #[classmethod]
+    fn load(_cls: &Bound<'_, PyType>, py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        py.detach(|| NdtGrid::load(&path))
+            .map(Self::from)
+            .map_err(to_py)
+    }
+
+    /// Pickle (and `copy`) through the file format's bytes.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Reduced<'py>> {
+        let from_bytes = py.get_type::<Self>().getattr("from_bytes")?;
+        Ok((from_bytes, (self.to_bytes(py)?,)))
+    }
 }
+
+/// What `__reduce__` returns: a constructor from bytes and the bytes.
+pub(crate) type Reduced<'py> = (Bound<'py, PyAny>, (Bound<'py, PyBytes>,));
 
 fn points_arg<'py>(obj: &Bound<'py, PyAny>) -> PyResult<crate::convert::Points<'py>> {
     points(obj, "points")

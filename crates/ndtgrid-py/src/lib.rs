@@ -20,6 +20,7 @@ use pyo3::prelude::*;
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("FORMAT_VERSION", ndt_core::persist::VERSION)?;
     m.add_class::<grid::PyNdtGrid>()?;
     m.add_class::<result::PyMatchResult>()?;
     m.add_class::<mapper::PyMapper>()?;

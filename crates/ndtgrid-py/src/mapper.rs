@@ -4,16 +4,17 @@
 //! (one `Arc<RwLock<NdtGrid>>`); the filter state sits in its own lock. Locks
 //! are taken with the GIL released, the grid's first, always in that order.
 
+use std::path::PathBuf;
 use std::sync::{Arc, Mutex, RwLock};
 
 use ndt_core::{MapFilter, NdtGrid, Pose2};
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBytes, PyDict, PyType};
 
 use crate::convert::vector;
 use crate::errors::{poisoned, to_py};
-use crate::grid::PyNdtGrid;
+use crate::grid::{PyNdtGrid, Reduced};
 use crate::mapper_options::PyMapperOptions;
 use crate::small_object::{PyRemovalCounts, PySmallObject};
 
@@ -60,8 +61,13 @@ impl PyMapper {
 impl PyMapper {
     /// A Python mapper holding `mapper` (a copy handed out by another object).
     pub(crate) fn from_core(py: Python<'_>, mapper: ndt_core::Mapper) -> PyResult<Self> {
-        let options = Py::new(py, PyMapperOptions::from(*mapper.filter().options()))?;
         let (grid, filter) = mapper.into_parts();
+        Self::from_parts(py, grid, filter)
+    }
+
+    /// A Python mapper of a grid and a filter state (e.g. loaded from a file).
+    fn from_parts(py: Python<'_>, grid: NdtGrid, filter: MapFilter) -> PyResult<Self> {
+        let options = Py::new(py, PyMapperOptions::from(*filter.options()))?;
         let grid = Arc::new(RwLock::new(grid));
         let grid_handle = Py::new(py, PyNdtGrid::shared(Arc::clone(&grid)))?;
         Ok(Self {
@@ -201,5 +207,46 @@ impl PyMapper {
     /// Runs the periodic checks (b-1, c) now; returns the cells deleted.
     fn run_checks(&self, py: Python<'_>) -> PyResult<usize> {
         self.with_both_mut(py, |g, f| f.run_checks(g))
+    }
+
+    /// The bytes of a mapper file (what `save` writes).
+    fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let bytes = self
+            .with_both(py, ndt_core::persist::mapper_to_bytes)?
+            .map_err(to_py)?;
+        Ok(PyBytes::new(py, &bytes))
+    }
+
+    /// The mapper of a mapper file's bytes.
+    #[classmethod]
+    fn from_bytes(_cls: &Bound<'_, PyType>, py: Python<'_>, data: &[u8]) -> PyResult<Self> {
+        let (grid, filter) = py
+            .detach(|| ndt_core::persist::mapper_from_bytes(data))
+            .map_err(to_py)?;
+        Self::from_parts(py, grid, filter)
+    }
+
+    /// Saves the mapper (grid and filter state) to a file, atomically.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let bytes = self
+            .with_both(py, ndt_core::persist::mapper_to_bytes)?
+            .map_err(to_py)?;
+        py.detach(|| ndt_core::persist::write_atomic(&path, &bytes))
+            .map_err(to_py)
+    }
+
+    /// Loads a mapper saved by `save`.
+    #[classmethod]
+    fn load(_cls: &Bound<'_, PyType>, py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let (grid, filter) = py
+            .detach(|| ndt_core::persist::load_mapper_parts(&path))
+            .map_err(to_py)?;
+        Self::from_parts(py, grid, filter)
+    }
+
+    /// Pickle (and `copy`) through the file format's bytes.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Reduced<'py>> {
+        let from_bytes = py.get_type::<Self>().getattr("from_bytes")?;
+        Ok((from_bytes, (self.to_bytes(py)?,)))
     }
 }

@@ -5,7 +5,9 @@
   occupied cells and the free space of the beams, saved as a ROS ``map_server`` map
   (``.pgm`` + ``.yaml``).
 - :func:`write_png`: the same image with the trajectory, as a PNG (extra ``plot``).
-- :func:`save_map` / :func:`load_map`: a map file that loads back identical (``.npz``).
+- :func:`save_map` / :func:`load_map`: a map file that loads back identical (the
+  versioned, checksummed ndtgrid format; :func:`load_map` also reads the ``.npz`` of
+  earlier releases).
 """
 
 from __future__ import annotations

@@ -1,9 +1,16 @@
-"""A map file that loads back identical: the grid's exact cell state in a numpy ``.npz``.
+"""Map files: the versioned, checksummed ndtgrid format, and the ``.npz`` of earlier releases.
 
-This is a stopgap: the versioned, checksummed binary format (``NdtGrid.save`` /
-``NdtGrid.load``, also used by pickle) is a later issue. The ``.npz`` holds the arrays of
-:meth:`ndtgrid.NdtGrid.cell_states` (eq. 6 sums about each cell's centre, so nothing is
-rounded on the way) and ``cell_size``, ``format`` and ``version`` entries.
+:func:`save_map` writes :meth:`ndtgrid.NdtGrid.save`'s file (``.ndtgrid`` by
+convention): magic bytes ``NDTGRID\\0``, kind, format version, payload length and a
+CRC-32, then the grid's exact cell state (eq. 6 sums about each cell's centre, so
+nothing is rounded), its cell size and pyramid levels. It is written atomically (a
+temporary file beside the target, synced, then renamed over it). Pickling a grid uses
+the same bytes. See the README's "Persistence" section.
+
+:func:`load_map` reads that format, and, for back-compatibility, the ``.npz`` map
+files that earlier releases wrote (numpy arrays of :meth:`~ndtgrid.NdtGrid.cell_states`
+with ``format = "ndtgrid-cells"``, ``version = 1``, ``cell_size`` entries); such a
+grid gets the default pyramid levels, as it did then.
 """
 
 from __future__ import annotations
@@ -12,46 +19,47 @@ import os
 
 import numpy as np
 
-from ndtgrid._core import NdtGrid
+from ndtgrid._core import FORMAT_VERSION, Mapper, NdtGrid
 
-__all__ = ["FORMAT", "VERSION", "load_map", "save_map"]
+__all__ = ["FORMAT_VERSION", "MAGIC", "NPZ_FORMAT", "NPZ_VERSION", "load_map", "save_map"]
 
-#: Value of the ``format`` entry.
-FORMAT = "ndtgrid-cells"
-#: Value of the ``version`` entry.
-VERSION = 1
+#: The first bytes of every ndtgrid file.
+MAGIC = b"NDTGRID\x00"
+#: The ``format`` entry of the ``.npz`` map files of earlier releases.
+NPZ_FORMAT = "ndtgrid-cells"
+#: The ``version`` entry of those files.
+NPZ_VERSION = 1
+#: The first bytes of a zip archive (an ``.npz`` file).
+_ZIP_MAGIC = b"PK\x03\x04"
 
 
-def save_map(path: str | os.PathLike[str], grid: NdtGrid) -> None:
-    """Save a grid's cells to an ``.npz`` file.
+def save_map(path: str | os.PathLike[str], grid: NdtGrid | Mapper) -> None:
+    """Save a map to an ndtgrid file, atomically.
 
     Parameters
     ----------
     path : str or os.PathLike
-        The file to write (numpy adds ``.npz`` when the name lacks it).
-    grid : NdtGrid
-        The map.
+        The file to write (replaced whole if it exists; ``.ndtgrid`` by convention).
+    grid : NdtGrid or Mapper
+        The map: a grid file for an :class:`~ndtgrid.NdtGrid`, a mapper file (grid and
+        filter state) for a :class:`~ndtgrid.Mapper`.
+
+    Raises
+    ------
+    OSError
+        If the file cannot be written (the message names it; an existing file is left
+        as it was).
     """
-    indices, counts, sums, scatters = grid.cell_states()
-    np.savez_compressed(
-        path,
-        format=np.array(FORMAT),
-        version=np.array(VERSION),
-        cell_size=np.array(grid.cell_size),
-        indices=indices,
-        counts=counts,
-        sums=sums,
-        scatters=scatters,
-    )
+    grid.save(path)
 
 
 def load_map(path: str | os.PathLike[str]) -> NdtGrid:
-    """Load a grid saved by :func:`save_map`.
+    """Load a grid saved by :func:`save_map` (or an ``.npz`` map of an earlier release).
 
     Parameters
     ----------
     path : str or os.PathLike
-        The ``.npz`` file.
+        A grid file, or a legacy ``.npz`` map file.
 
     Returns
     -------
@@ -60,17 +68,28 @@ def load_map(path: str | os.PathLike[str]) -> NdtGrid:
 
     Raises
     ------
+    OSError
+        If the file cannot be read (the message names it).
     ValueError
-        If the file is not a map file of this version, or a cell is invalid (message names
-        the file).
+        If the file is not a grid file of a supported version, is corrupt, or a cell
+        is invalid (the message names the file and the problem).
     """
+    with open(path, "rb") as f:
+        head = f.read(len(_ZIP_MAGIC))
+    if head == _ZIP_MAGIC:
+        return _load_npz(path)
+    return NdtGrid.load(path)
+
+
+def _load_npz(path: str | os.PathLike[str]) -> NdtGrid:
+    """The grid of an ``.npz`` map file of an earlier release."""
     with np.load(path, allow_pickle=False) as data:
         fmt = str(data["format"]) if "format" in data.files else None
         version = int(data["version"]) if "version" in data.files else None
-        if fmt != FORMAT or version != VERSION:
+        if fmt != NPZ_FORMAT or version != NPZ_VERSION:
             raise ValueError(
-                f"{path}: expected an {FORMAT} map file of version {VERSION}, got format "
-                f"{fmt!r} version {version!r}"
+                f"{path}: expected an {NPZ_FORMAT} map file of version {NPZ_VERSION}, got "
+                f"format {fmt!r} version {version!r}"
             )
         try:
             grid: NdtGrid = NdtGrid.from_cell_states(

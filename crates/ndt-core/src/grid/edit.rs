@@ -6,6 +6,11 @@ use crate::cell::CellStats;
 use crate::error::{NdtError, Result};
 use crate::key::{CellKey, MAX_INDEX};
 
+/// Largest point count a stored cell may have: far beyond any real map
+/// (2^62 points), and far enough from `u64::MAX` that adding scans cannot
+/// overflow.
+pub const MAX_CELL_COUNT: u64 = 1 << 62;
+
 impl NdtGrid {
     /// The exact state of every cell, sorted by key: its index and its eq. (6)
     /// sums about the cell's own centre (the grid's internal representation,
@@ -22,10 +27,21 @@ impl NdtGrid {
     /// ([`super::DEFAULT_LEVELS`]) holding exactly `states` (as returned by
     /// [`NdtGrid::cell_states`]); the coarser levels are summed from them.
     ///
-    /// Errors on an invalid cell size, and on a cell with a count of 0, a
-    /// non-finite sum, an index beyond ±[`MAX_INDEX`], or a key given twice.
+    /// Errors on an invalid cell size, and on a cell with a count of 0 or
+    /// beyond [`MAX_CELL_COUNT`], a non-finite sum, an index beyond
+    /// ±[`MAX_INDEX`], or a key given twice.
     pub fn from_cell_states(cell_size: f64, states: &[(CellKey, CellStats)]) -> Result<Self> {
-        let mut grid = NdtGrid::new(cell_size)?;
+        Self::from_cell_states_with_levels(cell_size, super::DEFAULT_LEVELS, states)
+    }
+
+    /// [`NdtGrid::from_cell_states`] with `levels` pyramid levels (see
+    /// [`NdtGrid::with_levels`]).
+    pub fn from_cell_states_with_levels(
+        cell_size: f64,
+        levels: usize,
+        states: &[(CellKey, CellStats)],
+    ) -> Result<Self> {
+        let mut grid = NdtGrid::with_levels(cell_size, levels)?;
         let mut seen = rustc_hash::FxHashSet::default();
         for (index, (key, stats)) in states.iter().enumerate() {
             let bad = |reason| Err(NdtError::InvalidCell { index, reason });
@@ -34,6 +50,9 @@ impl NdtGrid {
             }
             if stats.count == 0 {
                 return bad("has a count of 0 (empty cells are not stored)");
+            }
+            if stats.count > MAX_CELL_COUNT {
+                return bad("has a count beyond 2**62");
             }
             let finite = stats.sum.iter().chain(stats.scatter.iter());
             if !finite.into_iter().all(|v| v.is_finite()) {

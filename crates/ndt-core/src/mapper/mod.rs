@@ -8,9 +8,11 @@
 mod counts;
 mod options;
 mod pipeline;
+mod restore;
 
 pub use counts::RemovalCounts;
 pub use options::MapperOptions;
+pub use restore::MAX_COUNTER;
 
 use crate::error::Result;
 use crate::filter::areas::unconfirmed_small;
@@ -159,6 +161,12 @@ impl Mapper {
     /// The map matched against.
     pub fn grid(&self) -> &NdtGrid {
         &self.grid
+    }
+
+    /// A mapper of `grid` and the filter state `filter` (e.g. as taken
+    /// apart by [`Mapper::into_parts`], or loaded by [`crate::persist`]).
+    pub fn from_parts(grid: NdtGrid, filter: MapFilter) -> Self {
+        Self { grid, filter }
     }
 
     /// The grid and the filter state, taken apart.
