@@ -11,7 +11,7 @@ which two independent peers agree (see :func:`urg_pairs`). Simulated pairs come
 from ``ndtgrid.sim`` (the sticks room, URG-04LX and
 SICK-like presets, with the simulator's noise and false detections).
 
-Run: ``python benches/convergence.py [--pairs 12] [--starts 8] [--sim-pairs 8] [--held-out]``;
+Run: ``python benches/convergence.py [--pairs 12] [--starts 8] [--sim-pairs 8] [--offset 0.5]``;
 prints a Markdown table per pair set and start set.
 """
 
@@ -106,9 +106,9 @@ def sim_pairs(count: int, seed: int = 0) -> Iterator[Pair]:
             yield Pair(f"sim {laser.name}", apply(a, pa), pb, b, (0.02, np.radians(0.5)))
 
 
-def real_pairs(per_log: int, held_out: bool = False) -> Iterator[Pair]:
-    """``per_log`` consecutive corrected pairs spread evenly over each log; with
-    ``held_out``, the pairs half-way between those (a set no default was chosen on)."""
+def real_pairs(per_log: int, offset: float = 0.0) -> Iterator[Pair]:
+    """``per_log`` consecutive corrected pairs spread evenly over each log; with an
+    ``offset`` in (0, 1), the pairs that far between those (0.5: the held-out set)."""
     for name, (log, csv) in LOGS.items():
         if not (REAL / "radish-gfs-corrected" / log).exists():
             print(f"skipped {name}: ../shared/data/real absent")
@@ -116,9 +116,9 @@ def real_pairs(per_log: int, held_out: bool = False) -> Iterator[Pair]:
         scans = list(read_carmen(REAL / "radish-gfs-corrected" / log))
         index = read_benchmark_index(REAL / "benchmark-scans-split" / csv)
         pairs = list(corrected_pairs(scans, index, max_range=MAX_RANGE))
-        at = np.linspace(0, len(pairs) - 1, per_log + held_out)
-        if held_out:
-            at = 0.5 * (at[:-1] + at[1:])
+        at = np.linspace(0, len(pairs) - 1, per_log + (offset > 0))
+        if offset > 0:
+            at = at[:-1] + offset * (at[1:] - at[:-1])
         for k in at.astype(int):
             p = pairs[k]
             target = apply(p.reference_pose, p.reference_points)
@@ -164,7 +164,8 @@ def methods() -> list[peer_lib.Peer]:
             0.02,
             **{**PAPER, "levels": None, "rotation_search": 0.15},
         ),
-        ours("  + frozen unconstrained directions, r=1 = default match()", 0.02),
+        ours("  + frozen unconstrained directions, r=1", 0.02, shape_cell=0.0),
+        ours("  + fine cells shaped by their 32 cm ancestor = default match()", 0.02),
         ours("default + 3×3 pairing", 0.02, pair_neighbors=True),
         ours("16 cm grid, default match() (not 2 cm)", 0.16),
     ]
@@ -212,16 +213,17 @@ def main() -> None:
     ap.add_argument("--sim-pairs", type=int, default=8, help="pairs per simulated laser")
     ap.add_argument("--urg-pairs", type=int, default=40, help="candidate pairs of the URG log")
     ap.add_argument(
-        "--held-out",
-        action="store_true",
-        help="real pairs half-way between the default ones (a set no default was tuned on)",
+        "--offset",
+        type=float,
+        default=0.0,
+        help="real pairs this far (0-1) between the default ones: 0.5 is the held-out set",
     )
     args = ap.parse_args()
     ms = methods()
     sets = [
         (
-            "Held-out real pairs" if args.held_out else "Real pairs",
-            list(real_pairs(args.pairs, args.held_out)),
+            f"Real pairs at offset {args.offset:g}" if args.offset else "Real pairs",
+            list(real_pairs(args.pairs, args.offset)),
         ),
         ("Real URG-04LX pairs (peer-consensus reference)", list(urg_pairs(args.urg_pairs))),
         ("Simulated pairs", list(sim_pairs(args.sim_pairs, args.seed))),

@@ -49,7 +49,7 @@ def main() -> None:
     args = ap.parse_args()
     sets = {
         "SICK pairs": list(cv.real_pairs(args.pairs)),
-        "held-out SICK pairs": list(cv.real_pairs(args.pairs, held_out=True)),
+        "held-out SICK pairs": list(cv.real_pairs(args.pairs, offset=0.5)),
         "URG-04LX pairs": list(cv.urg_pairs(40)),
         "simulated pairs": list(cv.sim_pairs(8, args.seed)),
     }

@@ -142,6 +142,7 @@ class NdtGrid:
         *,
         expansion: float = 10.0,
         sigma_floor: float = 0.01,
+        shape_cell: float = 0.32,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
         pair_neighbors: bool = False,
@@ -183,6 +184,14 @@ class NdtGrid:
             was the best of 0.5-3 cm over the real pairs of
             ``benches/convergence.py`` (benchmark and held-out SICK pairs, URG-04LX
             pairs; BENCHMARK.md); lower it for a more precise sensor.
+        shape_cell : float, default 0.32
+            Cells finer than this [m] keep their own mean but take the covariance
+            of the pyramid cell of at least this size that holds them (the wall
+            segment they lie on), so that fine cells constrain a scan across a
+            surface and hardly along it: against a single sparse scan, isotropic
+            2 cm blobs pull the match towards where that scan sampled a wall (in
+            a corridor, towards zero motion). 0 turns it off (the paper's
+            distributions, eq. 7 and fusion).
         neighbor_search : bool, default True
             §IV-A(1): a point whose own cell has no distribution is paired with
             the distribution whose mean is nearest to it among the first ring of
@@ -251,6 +260,7 @@ class NdtGrid:
         *,
         expansion: float = 10.0,
         sigma_floor: float = 0.01,
+        shape_cell: float = 0.32,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
         pair_neighbors: bool = False,
@@ -915,6 +925,7 @@ class OdometryLoop:
         prior_gap_angle: float | None = None,
         expansion: float | None = None,
         sigma_floor: float | None = None,
+        shape_cell: float | None = None,
         neighbor_search: bool | None = None,
         fuse_minority: bool | None = None,
         search_radius: int | None = None,

@@ -6,7 +6,7 @@ Examples
 >>> from ndtgrid.presets import ORIGINAL_NDT, PAPER
 >>> grid = ndtgrid.NdtGrid(0.02)
 >>> sorted(PAPER)
-['freeze_unconstrained', 'levels', 'rotation_search', 'search_radius', 'sigma_floor']
+['freeze_unconstrained', 'levels', 'rotation_search', 'search_radius', 'shape_cell', 'sigma_floor']
 """
 
 from __future__ import annotations
@@ -18,10 +18,12 @@ __all__ = ["ORIGINAL_NDT", "PAPER"]
 #: Takubo et al. (IROS 2009) alone: the fine grid only, k = 10, neighbour search (3 cells)
 #: and minority fusion, no pyramid, no rotational multi-start, no frozen directions; the
 #: covariance regularised only up to a 5 mm standard deviation (about a URG-04LX's or a
-#: SICK's range noise; the paper states none), not the default's 1 cm.
+#: SICK's range noise; the paper states none), not the default's 1 cm; each cell's own
+#: covariance (eq. 7), not its pyramid ancestor's (``shape_cell=0``).
 PAPER: dict[str, Any] = {
     "levels": 1,
     "sigma_floor": 0.005,
+    "shape_cell": 0.0,
     "rotation_search": 0.0,
     "freeze_unconstrained": False,
     "search_radius": 3,

@@ -143,8 +143,39 @@ impl Gaussian {
             return None;
         }
         let (q, cov) = stats.mean_and_covariance()?;
+        Self::from_moments(origin + q, &cov, sigma_floor, k)
+    }
+
+    /// A cell's own mean with the covariance *shape* of a larger region that
+    /// holds it (see [`crate::shape`]): mean `origin + m/M` from `own` (any
+    /// number of points ≥ 1), covariance of eq. (7) from `region` (≥
+    /// [`MIN_POINTS`] points), regularised and expanded as in
+    /// [`Gaussian::from_stats`]. `None` when either has too few points.
+    pub fn with_shape(
+        own: &CellStats,
+        origin: Vector2<f64>,
+        region: &CellStats,
+        sigma_floor: f64,
+        k: f64,
+    ) -> Option<Gaussian> {
+        if region.count < MIN_POINTS {
+            return None;
+        }
+        let (q, _) = own.mean_and_covariance()?;
+        let (_, cov) = region.mean_and_covariance()?;
+        Self::from_moments(origin + q, &cov, sigma_floor, k)
+    }
+
+    /// Regularises covariance `cov` (see [`EIGEN_RATIO`], `sigma_floor`) and
+    /// expands it by `k` (eq. 8).
+    fn from_moments(
+        mean: Vector2<f64>,
+        cov: &Matrix2<f64>,
+        sigma_floor: f64,
+        k: f64,
+    ) -> Option<Gaussian> {
         let floor = sigma_floor * sigma_floor;
-        let (l1, l2, v1) = symmetric_eigen2(&cov);
+        let (l1, l2, v1) = symmetric_eigen2(cov);
         let l1 = l1.max(floor);
         let l2 = l2.max(EIGEN_RATIO * l1).max(floor);
         // eq. (8): expand both eigenvalues by k.
@@ -157,7 +188,7 @@ impl Gaussian {
             return None;
         }
         Some(Gaussian {
-            mean: origin + q,
+            mean,
             inverse,
             normal: v2,
         })

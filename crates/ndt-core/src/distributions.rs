@@ -1,12 +1,15 @@
 //! The normal distributions the matcher pairs points with, derived from the
-//! grid's sums: eq. (7) per cell, expanded by `k` (eq. 8), and for cells with
-//! fewer than 3 points the fused distribution of §IV-A(3).
+//! grid's sums: eq. (7) per cell, expanded by `k` (eq. 8), for cells with
+//! fewer than 3 points the fused distribution of §IV-A(3), and for cells
+//! finer than the shape scale the covariance of their ancestor
+//! ([`crate::shape`]).
 
 use nalgebra::Vector2;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::cell::{CellStats, Gaussian, MIN_POINTS};
 use crate::key::CellKey;
+use crate::shape::Shape;
 
 /// What decides a cell's distribution besides its sums.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -20,6 +23,9 @@ pub struct DistOptions {
     /// Smallest standard deviation of a distribution before expansion [m]
     /// (see [`crate::cell::DEFAULT_SIGMA_FLOOR`]).
     pub sigma_floor: f64,
+    /// Cells finer than this [m] take the covariance of their ancestor of
+    /// (at least) this size ([`crate::shape`]); 0 = off.
+    pub shape_cell: f64,
 }
 
 /// The distribution of every cell that has one, for one [`DistOptions`].
@@ -28,21 +34,25 @@ pub struct Distributions {
     options: DistOptions,
     level: usize,
     cell_size: f64,
+    /// Levels up to the shape level (0: no shape level applies).
+    shape_depth: usize,
     map: FxHashMap<CellKey, Gaussian>,
 }
 
 impl Distributions {
-    /// Builds the distributions of all cells.
+    /// Builds the distributions of all cells; `shape`: the ancestors whose
+    /// covariance they take (see [`crate::shape`]), if a shape level applies.
     pub fn build(
         cells: &FxHashMap<CellKey, CellStats>,
         cell_size: f64,
         level: usize,
         options: DistOptions,
+        shape: Option<Shape<'_>>,
     ) -> Self {
         let mut map = FxHashMap::default();
         map.reserve(cells.len());
         for &key in cells.keys() {
-            if let Some(g) = distribution_of(cells, cell_size, options, key) {
+            if let Some(g) = distribution_of(cells, cell_size, options, shape, key) {
                 map.insert(key, g);
             }
         }
@@ -50,20 +60,33 @@ impl Distributions {
             options,
             level,
             cell_size,
+            shape_depth: shape.map_or(0, |s| s.depth),
             map,
         }
     }
 
+    /// Levels between these distributions' level and their shape level (0:
+    /// none applies).
+    pub fn shape_depth(&self) -> usize {
+        self.shape_depth
+    }
+
     /// Recomputes the cells whose distribution may have changed after the
-    /// cells `touched` gained or lost points: those cells, and with fusion their 8
-    /// neighbours (whose fused sums include them).
+    /// cells `touched` gained or lost points: those cells, with fusion their 8
+    /// neighbours (whose fused sums include them), and with a shape level
+    /// every cell under the same ancestors (`shape`: that level, whose cells
+    /// must already include the change; the same depth as at build).
     pub fn update(
         &mut self,
         cells: &FxHashMap<CellKey, CellStats>,
         cell_size: f64,
         touched: &[CellKey],
+        shape: Option<Shape<'_>>,
     ) {
-        let mut affected: FxHashSet<CellKey> = FxHashSet::default();
+        let mut affected: FxHashSet<CellKey> = match shape {
+            Some(s) => s.descendants_of_touched(cells, touched),
+            None => FxHashSet::default(),
+        };
         for &key in touched {
             affected.insert(key);
             if self.options.fuse_minority {
@@ -79,7 +102,7 @@ impl Distributions {
             }
         }
         for key in affected {
-            match distribution_of(cells, cell_size, self.options, key) {
+            match distribution_of(cells, cell_size, self.options, shape, key) {
                 Some(g) => {
                     self.map.insert(key, g);
                 }
@@ -127,10 +150,19 @@ fn distribution_of(
     cells: &FxHashMap<CellKey, CellStats>,
     cell_size: f64,
     options: DistOptions,
+    shape: Option<Shape<'_>>,
     key: CellKey,
 ) -> Option<Gaussian> {
     let own = cells.get(&key)?;
     let centre = key.center(cell_size);
+    // Own mean, the ancestor's covariance (crate::shape), when the ancestor
+    // has a distribution of its own.
+    if let Some(region) = shape
+        .and_then(|s| s.ancestor(key))
+        .filter(|a| a.count >= MIN_POINTS)
+    {
+        return Gaussian::with_shape(own, centre, region, options.sigma_floor, options.expansion);
+    }
     if own.count >= MIN_POINTS || !options.fuse_minority {
         return Gaussian::from_stats(own, centre, options.sigma_floor, options.expansion);
     }

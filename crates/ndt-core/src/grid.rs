@@ -12,6 +12,7 @@ use crate::error::{check_finite, NdtError, Result};
 use crate::key::{CellKey, KeyBounds, MAX_INDEX};
 use crate::pyramid::{Level, Pyramid, MAX_LEVELS};
 use crate::se2::Pose2;
+use crate::shape::Shape;
 
 mod edit;
 
@@ -193,7 +194,8 @@ impl NdtGrid {
         for dist in prepared.iter_mut() {
             let l = dist.level();
             if let (Some(level), Some(keys)) = (self.pyramid.level(l), touched.get(l)) {
-                Arc::make_mut(dist).update(level.cells(), level.cell_size(), keys);
+                let shape = shape_at(&self.pyramid, l, dist.shape_depth());
+                Arc::make_mut(dist).update(level.cells(), level.cell_size(), keys, shape);
             }
         }
         Ok(touched.into_iter().next().unwrap_or_default())
@@ -218,7 +220,8 @@ impl NdtGrid {
         for dist in prepared.iter_mut() {
             let l = dist.level();
             if let (Some(level), Some(keys)) = (self.pyramid.level(l), touched.get(l)) {
-                Arc::make_mut(dist).update(level.cells(), level.cell_size(), keys);
+                let shape = shape_at(&self.pyramid, l, dist.shape_depth());
+                Arc::make_mut(dist).update(level.cells(), level.cell_size(), keys, shape);
             }
         }
         removed
@@ -252,11 +255,13 @@ impl NdtGrid {
         {
             return Some(Arc::clone(found));
         }
+        let depth = shape_depth(&self.pyramid, level, options.shape_cell);
         let built = Arc::new(Distributions::build(
             lv.cells(),
             lv.cell_size(),
             level,
             options,
+            shape_at(&self.pyramid, level, depth),
         ));
         if prepared.len() >= PREPARED_CAPACITY {
             prepared.remove(0);
@@ -270,6 +275,33 @@ impl NdtGrid {
         // the cache is rebuilt from the sums, so its content is still usable.
         self.prepared.lock().unwrap_or_else(|e| e.into_inner())
     }
+}
+
+/// Levels from `level` up to the first level whose cells are at least
+/// `shape_cell` [m] (see [`crate::shape`]); 0 when `shape_cell` is 0 or no
+/// coarser level is that large.
+fn shape_depth(pyramid: &Pyramid, level: usize, shape_cell: f64) -> usize {
+    if shape_cell <= 0.0 {
+        return 0;
+    }
+    (level + 1..pyramid.len())
+        .find(|&l| {
+            pyramid
+                .level(l)
+                .is_some_and(|lv| lv.cell_size() >= shape_cell * (1.0 - 1e-9))
+        })
+        .map_or(0, |l| l - level)
+}
+
+/// The shape level `depth` levels above `level`, if any.
+fn shape_at(pyramid: &Pyramid, level: usize, depth: usize) -> Option<Shape<'_>> {
+    if depth == 0 {
+        return None;
+    }
+    pyramid.level(level + depth).map(|lv| Shape {
+        cells: lv.cells(),
+        depth,
+    })
 }
 
 /// Rejects non-finite points.

@@ -37,6 +37,7 @@ pub mod pyramid;
 pub mod ranges;
 pub mod score;
 pub mod se2;
+pub mod shape;
 pub mod solver;
 
 pub use cell::{CellStats, Gaussian};

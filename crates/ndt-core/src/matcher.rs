@@ -27,6 +27,12 @@ pub const MAX_SEARCH_RADIUS: u32 = 1000;
 /// with a window of 2, 78 % / 73 % with 3.
 pub const LEVEL_WINDOW: usize = 2;
 
+/// Default [`MatchOptions::shape_cell`] [m]: fine cells take the covariance
+/// of the 32 cm cell they lie in (16 fine cells of 2 cm). Measured on the
+/// SICK pairs of `benches/convergence.py` (see BENCHMARK.md); off, 16 cm and
+/// 64 cm were worse on the held-out pairs.
+pub const DEFAULT_SHAPE_CELL: f64 = 0.32;
+
 /// Largest coarsest-level cell [m] of the automatic level count: the coarse
 /// stage must still see a room's walls as separate structures.
 pub const AUTO_COARSEST_CELL: f64 = 0.64;
@@ -52,6 +58,12 @@ pub struct MatchOptions {
     /// [`DEFAULT_SIGMA_FLOOR`] (1 cm), chosen by measurement (see there);
     /// lower it for a more precise sensor.
     pub sigma_floor: f64,
+    /// Cells finer than this [m] take the covariance shape of their ancestor
+    /// of at least this size, around their own mean ([`crate::shape`]): the
+    /// wall segment they lie on, so fine cells constrain a scan across a
+    /// surface, not along it. 0 = off (the paper's distributions). Default
+    /// [`DEFAULT_SHAPE_CELL`].
+    pub shape_cell: f64,
     /// §IV-A(1): pair points whose own cell has no distribution with a nearby
     /// cell's (see [`crate::neighbor::nearest_in_rings`]).
     pub neighbor_search: bool,
@@ -102,6 +114,7 @@ impl Default for MatchOptions {
         Self {
             expansion: 10.0,
             sigma_floor: DEFAULT_SIGMA_FLOOR,
+            shape_cell: DEFAULT_SHAPE_CELL,
             neighbor_search: true,
             search_radius: 1,
             fuse_minority: true,
@@ -126,6 +139,13 @@ impl MatchOptions {
         };
         positive("expansion", self.expansion)?;
         positive("sigma_floor", self.sigma_floor)?;
+        check_bound(
+            "shape_cell",
+            "a finite size >= 0 m",
+            self.shape_cell,
+            0.0,
+            false,
+        )?;
         positive("translation_tolerance", self.translation_tolerance)?;
         positive("rotation_tolerance", self.rotation_tolerance)?;
         positive("max_step_cells", self.max_step_cells)?;
@@ -168,6 +188,7 @@ impl MatchOptions {
         DistOptions {
             expansion: self.expansion,
             sigma_floor: self.sigma_floor,
+            shape_cell: self.shape_cell,
             fuse_minority: self.fuse_minority,
         }
     }

@@ -78,7 +78,8 @@ pub struct OdometryConfig {
     /// The σ floor is 5 mm, not the scan-to-scan default of 1 cm: the loop
     /// matches against a map of many scans, whose cells are well sampled
     /// (the simulated demo's RMS pose error: 0.36 cm with 5 mm, 0.94 cm with
-    /// 2 cm).
+    /// 2 cm). For the same reason fine cells keep their own covariance
+    /// (`shape_cell = 0`, see [`crate::shape`]).
     pub matcher: MatchOptions,
     /// The §V elimination applied to every inserted scan for the map the
     /// loop builds ([`Odometry::mapper`]; on by default: `outlier_filter =
@@ -114,6 +115,7 @@ impl Default for OdometryConfig {
             matcher: MatchOptions {
                 expansion: 30.0,
                 sigma_floor: ODOMETRY_SIGMA_FLOOR,
+                shape_cell: 0.0,
                 ..MatchOptions::default()
             },
             mapper: MapperOptions {

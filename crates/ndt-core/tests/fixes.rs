@@ -74,7 +74,9 @@ fn two_point_cell_gets_the_fused_distribution() {
             expansion: 1.0,
             fuse_minority: true,
             sigma_floor: 0.005,
+            shape_cell: 0.0,
         },
+        None,
     );
     let plain = Distributions::build(
         level.cells(),
@@ -84,7 +86,9 @@ fn two_point_cell_gets_the_fused_distribution() {
             expansion: 1.0,
             fuse_minority: false,
             sigma_floor: 0.005,
+            shape_cell: 0.0,
         },
+        None,
     );
     let key = CellKey { ix: 0, iy: 0 };
     assert!(
@@ -118,7 +122,9 @@ fn neighbour_search_pairs_a_point_outside_every_cell() {
             expansion: 10.0,
             fuse_minority: true,
             sigma_floor: 0.005,
+            shape_cell: 0.0,
         },
+        None,
     );
     // A point two cells above the wall: its own cell is empty.
     let p = Vector2::new(0.013, 0.052);

@@ -237,6 +237,7 @@ proptest! {
         guess in pose(),
         expansion in prop_oneof![0.5..50.0f64, Just(1e-300), Just(1e300), wild()],
         sigma_floor in prop_oneof![0.001..0.05f64, Just(1e-300), Just(1e300), wild()],
+        shape_cell in prop_oneof![Just(0.0), 0.0..1.0f64, Just(1e300), wild()],
         tol in prop_oneof![1e-6..1e-2f64, Just(1e-300), Just(1e300), wild()],
         max_step_cells in prop_oneof![0.5..5.0f64, Just(1e-300), Just(1e300), wild()],
         max_step_rotation in prop_oneof![0.01..0.5f64, Just(1e300), wild()],
@@ -250,6 +251,7 @@ proptest! {
         let options = MatchOptions {
             expansion,
             sigma_floor,
+            shape_cell,
             neighbor_search: flags[0],
             search_radius,
             fuse_minority: flags[1],
@@ -397,6 +399,7 @@ fn a_subnormal_expansion_gives_a_finite_score() {
     let options = MatchOptions {
         expansion: 1.2903343324094226e-308,
         sigma_floor: 0.005,
+        shape_cell: 0.0,
         neighbor_search: false,
         search_radius: 0,
         fuse_minority: false,

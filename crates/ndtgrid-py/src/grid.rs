@@ -114,7 +114,7 @@ impl PyNdtGrid {
 
     /// Matches scan-frame points against the map from `guess`.
     #[pyo3(name = "match", signature = (
-        points, guess, *, expansion = 10.0, sigma_floor = 0.01, neighbor_search = true, fuse_minority = true,
+        points, guess, *, expansion = 10.0, sigma_floor = 0.01, shape_cell = 0.32, neighbor_search = true, fuse_minority = true,
         pair_neighbors = false, search_radius = 1, max_iterations = 50, translation_tolerance = 1e-4,
         rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, rotation_search = 0.15, freeze_unconstrained = true,
         levels = None,
@@ -128,6 +128,7 @@ impl PyNdtGrid {
         guess: &Bound<'_, PyAny>,
         expansion: f64,
         sigma_floor: f64,
+        shape_cell: f64,
         neighbor_search: bool,
         fuse_minority: bool,
         pair_neighbors: bool,
@@ -145,6 +146,7 @@ impl PyNdtGrid {
         let options = MatchOptions {
             expansion,
             sigma_floor,
+            shape_cell,
             neighbor_search,
             search_radius: count("search_radius", search_radius)?,
             fuse_minority,
@@ -176,7 +178,7 @@ impl PyNdtGrid {
 
     /// Score terms of eq. (1) at `pose` without solving.
     #[pyo3(signature = (
-        points, pose, *, expansion = 10.0, sigma_floor = 0.01, neighbor_search = true, fuse_minority = true,
+        points, pose, *, expansion = 10.0, sigma_floor = 0.01, shape_cell = 0.32, neighbor_search = true, fuse_minority = true,
         pair_neighbors = false, search_radius = 1
     ))]
     #[allow(clippy::too_many_arguments)]
@@ -187,6 +189,7 @@ impl PyNdtGrid {
         pose: &Bound<'py, PyAny>,
         expansion: f64,
         sigma_floor: f64,
+        shape_cell: f64,
         neighbor_search: bool,
         fuse_minority: bool,
         pair_neighbors: bool,
@@ -196,6 +199,7 @@ impl PyNdtGrid {
         let options = MatchOptions {
             expansion,
             sigma_floor,
+            shape_cell,
             neighbor_search,
             fuse_minority,
             pair_neighbors,
@@ -321,6 +325,7 @@ pub fn default_match_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let out = PyDict::new(py);
     out.set_item("expansion", d.expansion)?;
     out.set_item("sigma_floor", d.sigma_floor)?;
+    out.set_item("shape_cell", d.shape_cell)?;
     out.set_item("neighbor_search", d.neighbor_search)?;
     out.set_item("fuse_minority", d.fuse_minority)?;
     out.set_item("pair_neighbors", d.pair_neighbors)?;

@@ -105,7 +105,7 @@ impl PyOdometry {
         cell_size = 0.02, *, min_range = None, max_range = None, insert_distance = None,
         insert_angle = None, map_window = None, min_match_ratio = None, rotation_search = None,
         rotation_step = None, prior_gap_distance = None, prior_gap_angle = None,
-        expansion = None, sigma_floor = None,
+        expansion = None, sigma_floor = None, shape_cell = None,
         neighbor_search = None, fuse_minority = None, search_radius = None,
         max_iterations = None, max_step_cells = None, max_step_rotation = None,
         levels = None, coarse_rotation_search = None, freeze_unconstrained = None,
@@ -127,6 +127,7 @@ impl PyOdometry {
         prior_gap_angle: Option<f64>,
         expansion: Option<f64>,
         sigma_floor: Option<f64>,
+        shape_cell: Option<f64>,
         neighbor_search: Option<bool>,
         fuse_minority: Option<bool>,
         search_radius: Option<i64>,
@@ -152,6 +153,7 @@ impl PyOdometry {
         let matcher = MatchOptions {
             expansion: expansion.unwrap_or(m.expansion),
             sigma_floor: sigma_floor.unwrap_or(m.sigma_floor),
+            shape_cell: shape_cell.unwrap_or(m.shape_cell),
             neighbor_search: neighbor_search.unwrap_or(m.neighbor_search),
             fuse_minority: fuse_minority.unwrap_or(m.fuse_minority),
             search_radius: search_radius
@@ -279,6 +281,7 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("prior_gap_angle", c.prior_gap_angle)?;
     out.set_item("expansion", c.matcher.expansion)?;
     out.set_item("sigma_floor", c.matcher.sigma_floor)?;
+    out.set_item("shape_cell", c.matcher.shape_cell)?;
     out.set_item("neighbor_search", c.matcher.neighbor_search)?;
     out.set_item("fuse_minority", c.matcher.fuse_minority)?;
     out.set_item("search_radius", c.matcher.search_radius)?;
