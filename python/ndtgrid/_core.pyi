@@ -161,11 +161,13 @@ class NdtGrid:
 
         The defaults are the paper's method (§IV-A: k = 10, neighbour search and
         fusion on) run coarse to fine over the pyramid (2-64 cm on a 2 cm
-        grid), with a rotational multi-start on the coarsest level and the
-        directions the scan does not constrain frozen: the best setting
+        grid), with a rotational multi-start on the coarsest level, the
+        directions the scan does not constrain frozen and fine cells shaped by
+        their 32 cm ancestor: the best setting
         measured by ``benches/convergence.py`` (BENCHMARK.md). The paper's
         method alone is ``levels=1, rotation_search=0.0,
-        freeze_unconstrained=False, search_radius=3``; the original NDT of
+        freeze_unconstrained=False, search_radius=3, sigma_floor=0.005,
+        shape_cell=0.0`` (``ndtgrid.presets.PAPER``); the original NDT of
         Biber & Strasser on the same grid is additionally ``expansion=1.0,
         neighbor_search=False, fuse_minority=False``.
 

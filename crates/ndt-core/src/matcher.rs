@@ -28,9 +28,13 @@ pub const MAX_SEARCH_RADIUS: u32 = 1000;
 pub const LEVEL_WINDOW: usize = 2;
 
 /// Default [`MatchOptions::shape_cell`] [m]: fine cells take the covariance
-/// of the 32 cm cell they lie in (16 fine cells of 2 cm). Measured on the
-/// SICK pairs of `benches/convergence.py` (see BENCHMARK.md); off, 16 cm and
-/// 64 cm were worse on the held-out pairs.
+/// of the 32 cm cell they lie in (16 × 16 fine cells of 2 cm). Measured with
+/// the default match on the SICK pairs of `benches/convergence.py` (success,
+/// local / wide starts; benchmark pairs | held-out pairs): off 81.5 / 79.6 |
+/// 75.3 / 73.9 %, 16 cm 80.8 / 79.1 | 77.9 / 76.4 %, 32 cm 80.8 / 78.9 |
+/// 79.3 / 77.5 %, 64 cm 75.8 / 74.5 | 77.2 / 75.1 %; then checked on two
+/// further sets chosen afterwards (`--offset 0.25`, `0.75`): off 75.7 / 73.9
+/// and 76.7 / 74.3 %, 32 cm 76.4 / 74.9 and 79.5 / 78.3 %.
 pub const DEFAULT_SHAPE_CELL: f64 = 0.32;
 
 /// Largest coarsest-level cell [m] of the automatic level count: the coarse
@@ -40,12 +44,14 @@ pub const AUTO_COARSEST_CELL: f64 = 0.64;
 /// Options of [`NdtGrid::match_scan`]. The defaults are the paper's method
 /// (§IV-A: `k = 10`, neighbour search and fusion on) run coarse to fine over
 /// the pyramid (2–64 cm on a 2 cm grid) with a ±0.15 rad rotational
-/// multi-start on the coarsest level and unconstrained directions frozen —
-/// the best of the settings measured by `benches/convergence.py` (see
+/// multi-start on the coarsest level, unconstrained directions frozen, a 1 cm
+/// σ floor and fine cells shaped by their 32 cm ancestor — the best of the
+/// settings measured by `benches/convergence.py` (see
 /// BENCHMARK.md). Neighbour search looks 1 cell around an empty cell (larger
 /// radii measured worse: points get paired with the wrong wall). The paper's
 /// method alone is `levels = Some(1), rotation_search = 0,
-/// freeze_unconstrained = false, search_radius = 3`; the original NDT of Biber
+/// freeze_unconstrained = false, search_radius = 3, sigma_floor = 0.005,
+/// shape_cell = 0`; the original NDT of Biber
 /// & Strasser on the same grid is additionally `expansion = 1`,
 /// `neighbor_search = false`, `fuse_minority = false`.
 #[derive(Debug, Clone, Copy, PartialEq)]
