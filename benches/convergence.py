@@ -11,8 +11,8 @@ which two independent peers agree (see :func:`urg_pairs`). Simulated pairs come
 from ``ndtgrid.sim`` (the sticks room, URG-04LX and
 SICK-like presets, with the simulator's noise and false detections).
 
-Run: ``python benches/convergence.py [--pairs 12] [--starts 8] [--sim-pairs 8] [--offset 0.5]``;
-prints a Markdown table per pair set and start set.
+Run: ``python benches/convergence.py [--pairs 12] [--starts 8] [--sim-pairs 8]
+[--offset 0 0.5 ...]``; prints a Markdown table per pair set and start set.
 """
 
 from __future__ import annotations
@@ -198,7 +198,8 @@ def run(
                 ok += et < pair.tol[0] and er < pair.tol[1]
         e = np.array(errs)
         print(
-            f"| {m.name} | {100 * ok / len(e):.0f} % | {100 * np.median(e[:, 0]):.1f} / "
+            f"| {m.name} | {100 * ok / len(e):.0f} % ({ok}/{len(e)}) | "
+            f"{100 * np.median(e[:, 0]):.1f} / "
             f"{np.degrees(np.median(e[:, 1])):.2f} | {1e3 * np.median(times):.2f} |",
             flush=True,
         )
@@ -215,15 +216,19 @@ def main() -> None:
     ap.add_argument(
         "--offset",
         type=float,
-        default=0.0,
-        help="real pairs this far (0-1) between the default ones: 0.5 is the held-out set",
+        nargs="+",
+        default=[0.0],
+        help="real pairs this far (0-1) between the default ones (0.5: the held-out set); "
+        "several offsets pool their pairs",
     )
     args = ap.parse_args()
     ms = methods()
     sets = [
         (
-            f"Real pairs at offset {args.offset:g}" if args.offset else "Real pairs",
-            list(real_pairs(args.pairs, args.offset)),
+            "Real pairs"
+            if args.offset == [0.0]
+            else f"Real pairs at offsets {', '.join(f'{o:g}' for o in args.offset)}",
+            [p for o in args.offset for p in real_pairs(args.pairs, o)],
         ),
         ("Real URG-04LX pairs (peer-consensus reference)", list(urg_pairs(args.urg_pairs))),
         ("Simulated pairs", list(sim_pairs(args.sim_pairs, args.seed))),
