@@ -154,6 +154,7 @@ class NdtGrid:
         max_step_rotation: float = 0.05,
         rotation_search: float = 0.15,
         freeze_unconstrained: bool = True,
+        freeze_ratio: float = 0.1,
         levels: int | None = None,
         expansion_phases: Sequence[float] | None = None,
     ) -> MatchResult:
@@ -227,10 +228,13 @@ class NdtGrid:
         freeze_unconstrained : bool, default True
             From the second pyramid stage on, project Newton steps onto the
             pose directions the scan constrains well (point-to-plane information:
-            curvature at least 10 % of the strongest, a stricter test than the 2 %
-            of ``MatchResult.unconstrained``): along a corridor's axis the pose
-            stays where the guess and the coarse stages put it instead of being
-            dragged by fine cells ("solution remapping").
+            curvature at least ``freeze_ratio`` of the strongest, a stricter test
+            than the 2 % of ``MatchResult.unconstrained``): along a corridor's
+            axis the pose stays where the guess and the coarse stages put it
+            instead of being dragged by fine cells ("solution remapping").
+        freeze_ratio : float, default 0.1
+            The curvature ratio (in [0, 1]) below which ``freeze_unconstrained``
+            freezes a direction (0.1 measured best of 0.005-0.2, BENCHMARK.md).
         levels : int, optional
             Pyramid levels to match on, coarse to fine (1 = the fine grid only,
             the paper's method; at most the grid's ``levels``). By default as
@@ -937,6 +941,7 @@ class OdometryLoop:
         levels: int | None = None,
         coarse_rotation_search: float | None = None,
         freeze_unconstrained: bool | None = None,
+        freeze_ratio: float | None = None,
         outlier_filter: bool | None = None,
         edge_removal: bool | None = None,
         backshift_rejection: bool | None = None,

@@ -104,6 +104,10 @@ pub struct MatchOptions {
     /// projected onto the constrained directions of the point-to-plane
     /// information (see [`crate::degeneracy::constrained_projector`]).
     pub freeze_unconstrained: bool,
+    /// With `freeze_unconstrained`: a direction is frozen when its curvature
+    /// is below this fraction of the strongest (in [0, 1]; default
+    /// [`crate::degeneracy::FREEZE_RATIO`]).
+    pub freeze_ratio: f64,
     /// Pyramid levels to match on, coarse to fine (1 = the fine grid only,
     /// the paper's method). Level `l` has cells `2^l` times the fine size.
     /// Stage `l` (from `levels − 1` down to 0) starts from the previous
@@ -132,6 +136,7 @@ impl Default for MatchOptions {
             max_step_rotation: 0.05,
             rotation_search: 0.15,
             freeze_unconstrained: true,
+            freeze_ratio: crate::degeneracy::FREEZE_RATIO,
             levels: None,
         }
     }
@@ -145,6 +150,13 @@ impl MatchOptions {
         };
         positive("expansion", self.expansion)?;
         positive("sigma_floor", self.sigma_floor)?;
+        if !(self.freeze_ratio.is_finite() && (0.0..=1.0).contains(&self.freeze_ratio)) {
+            return Err(NdtError::InvalidOption {
+                name: "freeze_ratio",
+                expected: "a ratio in [0, 1]",
+                value: self.freeze_ratio,
+            });
+        }
         check_bound(
             "shape_cell",
             "a finite size >= 0 m",
@@ -356,7 +368,7 @@ impl NdtGrid {
             if options.freeze_unconstrained && level + 1 < levels {
                 if let Some(d) = stack.first() {
                     let info = point_to_plane_information(own_cell_pairs(d, points, pose), pose);
-                    solver.projector = constrained_projector(&info, lever);
+                    solver.projector = constrained_projector(&info, lever, options.freeze_ratio);
                 }
             }
             let objective = |p: Pose2, order: Order| {

@@ -79,7 +79,9 @@ pub struct OdometryConfig {
     /// matches against a map of many scans, whose cells are well sampled
     /// (the simulated demo's RMS pose error: 0.36 cm with 5 mm, 0.94 cm with
     /// 2 cm). For the same reason fine cells keep their own covariance
-    /// (`shape_cell = 0`, see [`crate::shape`]).
+    /// (`shape_cell = 0`, see [`crate::shape`]), and directions are frozen
+    /// only below [`crate::degeneracy::DEGENERACY_RATIO`] (see
+    /// [`crate::degeneracy::FREEZE_RATIO`]).
     pub matcher: MatchOptions,
     /// The §V elimination applied to every inserted scan for the map the
     /// loop builds ([`Odometry::mapper`]; on by default: `outlier_filter =
@@ -116,6 +118,7 @@ impl Default for OdometryConfig {
                 expansion: 30.0,
                 sigma_floor: ODOMETRY_SIGMA_FLOOR,
                 shape_cell: 0.0,
+                freeze_ratio: crate::degeneracy::DEGENERACY_RATIO,
                 ..MatchOptions::default()
             },
             mapper: MapperOptions {

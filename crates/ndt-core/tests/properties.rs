@@ -238,6 +238,7 @@ proptest! {
         expansion in prop_oneof![0.5..50.0f64, Just(1e-300), Just(1e300), wild()],
         sigma_floor in prop_oneof![0.001..0.05f64, Just(1e-300), Just(1e300), wild()],
         shape_cell in prop_oneof![Just(0.0), 0.0..1.0f64, Just(1e300), wild()],
+        freeze_ratio in prop_oneof![0.0..1.0f64, Just(1.0), wild()],
         tol in prop_oneof![1e-6..1e-2f64, Just(1e-300), Just(1e300), wild()],
         max_step_cells in prop_oneof![0.5..5.0f64, Just(1e-300), Just(1e300), wild()],
         max_step_rotation in prop_oneof![0.01..0.5f64, Just(1e300), wild()],
@@ -263,6 +264,7 @@ proptest! {
             max_step_rotation,
             rotation_search,
             freeze_unconstrained: flags[3],
+            freeze_ratio,
             levels,
         };
         match grid.match_scan(&pts, guess, &options) {
@@ -411,6 +413,7 @@ fn a_subnormal_expansion_gives_a_finite_score() {
         max_step_rotation: 0.01,
         rotation_search: 0.0,
         freeze_unconstrained: false,
+        freeze_ratio: 0.1,
         levels: None,
     };
     let pts = [[-2.3763401613489026, 2.3516387683799254]];

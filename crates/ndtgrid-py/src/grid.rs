@@ -116,7 +116,7 @@ impl PyNdtGrid {
     #[pyo3(name = "match", signature = (
         points, guess, *, expansion = 10.0, sigma_floor = 0.01, shape_cell = 0.32, neighbor_search = true, fuse_minority = true,
         pair_neighbors = false, search_radius = 1, max_iterations = 50, translation_tolerance = 1e-4,
-        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, rotation_search = 0.15, freeze_unconstrained = true,
+        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, rotation_search = 0.15, freeze_unconstrained = true, freeze_ratio = 0.1,
         levels = None,
         expansion_phases = None
     ))]
@@ -140,6 +140,7 @@ impl PyNdtGrid {
         max_step_rotation: f64,
         rotation_search: f64,
         freeze_unconstrained: bool,
+        freeze_ratio: f64,
         levels: Option<i64>,
         expansion_phases: Option<Vec<f64>>,
     ) -> PyResult<PyMatchResult> {
@@ -158,6 +159,7 @@ impl PyNdtGrid {
             max_step_rotation,
             rotation_search,
             freeze_unconstrained,
+            freeze_ratio,
             levels: levels.map(|l| count("levels", l)).transpose()?,
         };
         let pts = points_arg(points)?;
@@ -337,6 +339,7 @@ pub fn default_match_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     out.set_item("max_step_rotation", d.max_step_rotation)?;
     out.set_item("rotation_search", d.rotation_search)?;
     out.set_item("freeze_unconstrained", d.freeze_unconstrained)?;
+    out.set_item("freeze_ratio", d.freeze_ratio)?;
     out.set_item("levels", d.levels)?;
     out.set_item("expansion_phases", py.None())?;
     Ok(out)
