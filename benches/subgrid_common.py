@@ -13,6 +13,7 @@ import numpy.typing as npt
 
 import ndtgrid
 from ndtgrid import se2, sim
+from ndtgrid.presets import SCAN_TO_MAP
 
 F64 = npt.NDArray[np.float64]
 
@@ -114,7 +115,7 @@ def build(
             pts = ndtgrid.ranges_to_points(
                 ranges[k], angles, min_range=max(min_range, 1e-9), max_range=max_range
             )
-            est = mapper.grid.match(pts, guess).pose if len(pts) >= 10 else guess
+            est = mapper.grid.match(pts, guess, **SCAN_TO_MAP).pose if len(pts) >= 10 else guess
         mapper.insert_scan(ranges[k], angles, est)
         used[k] = est
     ms = 1e3 * (time.perf_counter() - t0) / max(1, len(ranges))
