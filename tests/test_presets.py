@@ -36,3 +36,11 @@ def test_presets_are_accepted_and_change_the_match() -> None:
     }
     assert not np.array_equal(poses["default"], poses["scan_to_map"])
     assert not np.array_equal(poses["paper"], poses["biber"])
+
+
+def test_paper_presets_equal_the_cores() -> None:
+    from ndtgrid._core import preset_match_options
+
+    default = default_match_options()
+    assert {**default, **PAPER} == preset_match_options("paper")
+    assert {**default, **ORIGINAL_NDT} == preset_match_options("original_ndt")

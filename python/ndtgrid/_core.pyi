@@ -814,6 +814,17 @@ def default_mapper_options() -> dict[str, Any]:
 def default_match_options() -> dict[str, Any]:
     """The core's defaults for :meth:`NdtGrid.match`."""
 
+def preset_match_options(name: str) -> dict[str, Any]:
+    """The core's options of ``"paper"`` (``MatchOptions::paper``) or ``"original_ndt"``.
+
+    ``ndtgrid.presets.PAPER`` and ``ORIGINAL_NDT`` applied to the defaults give these.
+
+    Raises
+    ------
+    ValueError
+        For another name.
+    """
+
 def compose(a: ArrayLike, b: ArrayLike) -> F64Array:
     """``a o b``: pose ``b`` (given in frame ``a``) in ``a``'s parent frame, shape (3,)."""
 

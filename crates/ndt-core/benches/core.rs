@@ -61,13 +61,7 @@ fn bench_insert(c: &mut Criterion) {
 
 /// The paper's method alone (§IV-A on the fine grid only).
 fn paper() -> MatchOptions {
-    MatchOptions {
-        levels: Some(1),
-        rotation_search: 0.0,
-        freeze_unconstrained: false,
-        search_radius: 3,
-        ..MatchOptions::default()
-    }
+    MatchOptions::paper()
 }
 
 fn bench_match(c: &mut Criterion) {

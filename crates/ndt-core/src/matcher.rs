@@ -143,6 +143,35 @@ impl Default for MatchOptions {
 }
 
 impl MatchOptions {
+    /// The paper's method alone (§III-A with the fixes of §IV-A): the fine
+    /// grid only, `k = 10`, neighbour search (3 cells) and minority fusion;
+    /// no pyramid, rotational multi-start or frozen directions; each cell's
+    /// own covariance (eq. 7) regularised to a 5 mm σ (the paper states none).
+    /// Python: `ndtgrid.presets.PAPER`.
+    pub fn paper() -> Self {
+        Self {
+            levels: Some(1),
+            rotation_search: 0.0,
+            freeze_unconstrained: false,
+            search_radius: 3,
+            sigma_floor: 0.005,
+            shape_cell: 0.0,
+            ..Self::default()
+        }
+    }
+
+    /// Biber & Strasser's original NDT on the same grid: [`MatchOptions::paper`]
+    /// with `k = 1`, no neighbour search and no fusion. Python:
+    /// `ndtgrid.presets.ORIGINAL_NDT`.
+    pub fn original_ndt() -> Self {
+        Self {
+            expansion: 1.0,
+            neighbor_search: false,
+            fuse_minority: false,
+            ..Self::paper()
+        }
+    }
+
     /// Checks every option's range.
     pub fn validate(&self) -> Result<()> {
         let positive = |name: &'static str, value: f64| {

@@ -323,7 +323,25 @@ fn points_arg<'py>(obj: &Bound<'py, PyAny>) -> PyResult<crate::convert::Points<'
 /// check that the documented defaults are the ones in force.
 #[pyfunction]
 pub fn default_match_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
-    let d = MatchOptions::default();
+    options_dict(py, &MatchOptions::default())
+}
+
+/// The core's options of the paper's method alone (`MatchOptions::paper`)
+/// and of the original NDT (`MatchOptions::original_ndt`), so that the
+/// Python presets can be checked against them.
+#[pyfunction]
+pub fn preset_match_options<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>> {
+    match name {
+        "paper" => options_dict(py, &MatchOptions::paper()),
+        "original_ndt" => options_dict(py, &MatchOptions::original_ndt()),
+        _ => Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "name: expected 'paper' or 'original_ndt', got {name:?}"
+        ))),
+    }
+}
+
+/// `MatchOptions` as `match` keyword arguments.
+fn options_dict<'py>(py: Python<'py>, d: &MatchOptions) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     out.set_item("expansion", d.expansion)?;
     out.set_item("sigma_floor", d.sigma_floor)?;

@@ -33,6 +33,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<freespace::PyFreeSpace>()?;
     m.add_function(wrap_pyfunction!(odometry::default_odometry_config, m)?)?;
     m.add_function(wrap_pyfunction!(grid::default_match_options, m)?)?;
+    m.add_function(wrap_pyfunction!(grid::preset_match_options, m)?)?;
     m.add_function(wrap_pyfunction!(ranges::ranges_to_points, m)?)?;
     m.add_function(wrap_pyfunction!(se2::compose, m)?)?;
     m.add_function(wrap_pyfunction!(se2::inverse, m)?)?;
