@@ -11,6 +11,7 @@ from ndtgrid.presets import ORIGINAL_NDT, PAPER, SCAN_TO_MAP
 
 def test_scan_to_map_is_the_odometry_loops_matcher() -> None:
     loop = default_odometry_config()
+    assert SCAN_TO_MAP == {"sigma_floor": 0.005, "shape_cell": 0.0, "freeze_ratio": 0.02}
     for name, value in SCAN_TO_MAP.items():
         assert loop[name] == value, name
     # ... and differs from the scan-to-scan default in each of its settings.
@@ -42,5 +43,14 @@ def test_paper_presets_equal_the_cores() -> None:
     from ndtgrid._core import preset_match_options
 
     default = default_match_options()
+    assert sorted(PAPER) == [
+        "freeze_unconstrained",
+        "levels",
+        "rotation_search",
+        "search_radius",
+        "shape_cell",
+        "sigma_floor",
+    ]
+    assert set(ORIGINAL_NDT) == {*PAPER, "expansion", "neighbor_search", "fuse_minority"}
     assert {**default, **PAPER} == preset_match_options("paper")
     assert {**default, **ORIGINAL_NDT} == preset_match_options("original_ndt")
