@@ -55,6 +55,7 @@ class Pair:
     source: np.ndarray
     truth: np.ndarray
     tol: tuple[float, float] = (0.05, np.radians(1.0))  # success: error below [m, rad]
+    subset: str = ""  # the offset set a real pair belongs to (per-set table)
 
 
 def urg_pairs(count: int) -> Iterator[Pair]:
@@ -122,7 +123,7 @@ def real_pairs(per_log: int, offset: float = 0.0) -> Iterator[Pair]:
         for k in at.astype(int):
             p = pairs[k]
             target = apply(p.reference_pose, p.reference_points)
-            yield Pair(name, target, p.points, p.true_pose)
+            yield Pair(name, target, p.points, p.true_pose, subset=f"{offset:g}")
 
 
 def apply(pose: np.ndarray, pts: np.ndarray) -> np.ndarray:
@@ -180,13 +181,17 @@ def starts(rng: np.random.Generator, n: int, trans: float, rot_deg: float) -> np
 def run(
     pairs: list[Pair], ms: list[peer_lib.Peer], perturb: Callable[[int], np.ndarray], title: str
 ) -> None:
-    """Print one table: success, median error, median time per method."""
+    """Print one table: success, median error, median time per method; with pairs
+    from several offset sets, a second table of success per set."""
     print(f"\n### {title}\n")
+    subsets = sorted({p.subset for p in pairs}, key=float) if pairs[0].subset else []
+    per_set: list[str] = []
     print("| method | success | median error [cm / °] | median time [ms] |")
     print("|---|---|---|---|")
     deltas = [perturb(i) for i in range(len(pairs))]
     for m in ms:
         ok, errs, times = 0, [], []
+        by_set = dict.fromkeys(subsets, 0)
         for pair, delta in zip(pairs, deltas):
             state = m.prepare(pair.target)
             for d in delta:
@@ -195,7 +200,10 @@ def run(
                 times.append(time.perf_counter() - t0)
                 et, er = pose_error(pose, pair.truth)
                 errs.append((et, er))
-                ok += et < pair.tol[0] and er < pair.tol[1]
+                hit = et < pair.tol[0] and er < pair.tol[1]
+                ok += hit
+                if subsets:
+                    by_set[pair.subset] += hit
         e = np.array(errs)
         print(
             f"| {m.name} | {100 * ok / len(e):.0f} % ({ok}/{len(e)}) | "
@@ -203,6 +211,15 @@ def run(
             f"{np.degrees(np.median(e[:, 1])):.2f} | {1e3 * np.median(times):.2f} |",
             flush=True,
         )
+        starts_per_set = len(e) // max(len(subsets), 1)
+        per_set.append(
+            f"| {m.name} | " + " | ".join(f"{by_set[k]}/{starts_per_set}" for k in subsets) + " |"
+        )
+    if len(subsets) > 1:
+        print(f"\nSuccess per offset set ({title}):\n")
+        print("| method | " + " | ".join(f"offset {k}" for k in subsets) + " |")
+        print("|---|" + "---|" * len(subsets))
+        print("\n".join(per_set), flush=True)
 
 
 def main() -> None:
