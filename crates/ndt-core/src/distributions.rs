@@ -10,6 +10,7 @@ use rustc_hash::{FxHashMap, FxHashSet};
 use crate::cell::{CellStats, Gaussian, MIN_POINTS};
 use crate::key::CellKey;
 use crate::shape::Shape;
+use crate::table::{CellTable, Cursor};
 
 /// What decides a cell's distribution besides its sums.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,7 +37,7 @@ pub struct Distributions {
     cell_size: f64,
     /// Levels up to the shape level (0: no shape level applies).
     shape_depth: usize,
-    map: FxHashMap<CellKey, Gaussian>,
+    map: CellTable<Gaussian>,
 }
 
 impl Distributions {
@@ -49,8 +50,7 @@ impl Distributions {
         options: DistOptions,
         shape: Option<Shape<'_>>,
     ) -> Self {
-        let mut map = FxHashMap::default();
-        map.reserve(cells.len());
+        let mut map = CellTable::with_capacity(cells.len());
         for &key in cells.keys() {
             if let Some(g) = distribution_of(cells, cell_size, options, shape, key) {
                 map.insert(key, g);
@@ -106,9 +106,7 @@ impl Distributions {
                 Some(g) => {
                     self.map.insert(key, g);
                 }
-                None => {
-                    self.map.remove(&key);
-                }
+                None => self.map.remove(key),
             }
         }
     }
@@ -131,7 +129,19 @@ impl Distributions {
     /// The distribution of cell `key`, if it has one.
     #[inline]
     pub fn get(&self, key: CellKey) -> Option<&Gaussian> {
-        self.map.get(&key)
+        self.map.get(key)
+    }
+
+    /// A reader for runs of look-ups (a scan's points in order, a cell's
+    /// neighbours): see [`crate::table::Cursor`].
+    #[inline]
+    pub fn cursor(&self) -> Cursor<'_, Gaussian> {
+        self.map.cursor()
+    }
+
+    /// Bytes these distributions hold on the heap, look-up structure included.
+    pub fn heap_bytes(&self) -> usize {
+        self.map.heap_bytes()
     }
 
     /// Number of cells with a distribution.

@@ -40,9 +40,10 @@ pub fn own_cell_pairs<'a>(
     pose: Pose2,
 ) -> impl Iterator<Item = (Vector2<f64>, &'a crate::cell::Gaussian)> + 'a {
     let inv = 1.0 / dists.cell_size();
+    let mut cursor = dists.cursor();
     points.iter().filter_map(move |p| {
         let x = Vector2::new(p[0], p[1]);
         let key = crate::key::CellKey::of(pose.transform(x), inv)?;
-        dists.get(key).map(|g| (x, g))
+        cursor.get(key).map(|g| (x, g))
     })
 }

@@ -6,6 +6,21 @@ use nalgebra::Vector2;
 /// and coarse levels never overflow `i32`.
 pub const MAX_INDEX: i32 = 1 << 30;
 
+/// `⌊v⌋` as an index when `|⌊v⌋| < MAX_INDEX` (`None` otherwise and for
+/// NaN). The same value as `v.floor() as i32`, without the libm call that
+/// CPUs without SSE4.1's `roundsd` (the default x86-64 target) make for
+/// `floor`: this is on the matcher's per-point path.
+#[inline]
+fn floor_index(v: f64) -> Option<i32> {
+    let lim = f64::from(MAX_INDEX);
+    // ⌊v⌋ > −lim ⇔ v ≥ 1 − lim; ⌊v⌋ < lim ⇔ v < lim; both false for NaN.
+    if !(v >= 1.0 - lim && v < lim) {
+        return None;
+    }
+    let t = v as i32; // truncation toward zero, exact in this range
+    Some(if f64::from(t) > v { t - 1 } else { t })
+}
+
 /// The integer index `(⌊x / s⌋, ⌊y / s⌋)` of a cell of size `s` (floor division,
 /// so correct for negative coordinates).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -21,18 +36,10 @@ impl CellKey {
     /// exceed ±[`MAX_INDEX`] (or `p` is not finite).
     #[inline]
     pub fn of(p: Vector2<f64>, inv_cell_size: f64) -> Option<CellKey> {
-        let fx = (p.x * inv_cell_size).floor();
-        let fy = (p.y * inv_cell_size).floor();
-        let lim = MAX_INDEX as f64;
-        // NaN fails both comparisons and is rejected too.
-        if fx.abs() < lim && fy.abs() < lim {
-            Some(CellKey {
-                ix: fx as i32,
-                iy: fy as i32,
-            })
-        } else {
-            None
-        }
+        Some(CellKey {
+            ix: floor_index(p.x * inv_cell_size)?,
+            iy: floor_index(p.y * inv_cell_size)?,
+        })
     }
 
     /// Centre of the cell [m].
@@ -90,5 +97,59 @@ impl KeyBounds {
         keys.into_iter().fold(None, |b: Option<Self>, k| {
             Some(b.map_or_else(|| Self::of(k), |b| b.including(k)))
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The index the libm `floor` gives, with the original bounds check.
+    fn by_floor(v: f64) -> Option<i32> {
+        let f = v.floor();
+        (f.abs() < f64::from(MAX_INDEX)).then_some(f as i32)
+    }
+
+    #[test]
+    fn floor_index_equals_libm_floor() {
+        let lim = f64::from(MAX_INDEX);
+        let mut cases = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            1.0 - 1e-16,
+            -1e-300,
+            1e-300,
+            lim,
+            -lim,
+            lim - 1.0,
+            1.0 - lim,
+            0.5 - lim,
+            -lim + 1.0 - 1e-7,
+            lim - 1e-7,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            1e300,
+            -1e300,
+        ];
+        let mut x: u64 = 1;
+        for _ in 0..200_000 {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let u = (x >> 11) as f64 / (1u64 << 53) as f64;
+            let scale = [1.0, 100.0, 1e6, 2e9][(x & 3) as usize];
+            cases.push((2.0 * u - 1.0) * scale);
+            // Near-integers, where truncation and floor differ.
+            let n = ((x >> 20) % 2001) as f64 - 1000.0;
+            cases.extend([n, n - f64::EPSILON * n.abs(), n + f64::EPSILON * n.abs()]);
+        }
+        for v in cases {
+            assert_eq!(floor_index(v), by_floor(v), "v = {v:e}");
+        }
     }
 }

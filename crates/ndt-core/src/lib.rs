@@ -39,6 +39,7 @@ pub mod score;
 pub mod se2;
 pub mod shape;
 pub mod solver;
+pub mod table;
 
 pub use cell::{CellStats, Gaussian};
 pub use error::{NdtError, Result};

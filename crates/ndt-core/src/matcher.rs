@@ -11,10 +11,11 @@ use crate::error::{check_bound, check_finite, NdtError, Result};
 use crate::grid::{check_points, NdtGrid};
 use crate::information::{own_cell_pairs, point_to_plane_information};
 use crate::key::CellKey;
-use crate::neighbor::nearest_in_rings;
-use crate::score::{Order, ScoreTerms};
+use crate::neighbor::nearest_in_rings_with;
+use crate::score::{Accumulator, Order, ScoreTerms};
 use crate::se2::Pose2;
 use crate::solver::{covariance_from_hessian, minimise, SolverOptions};
+use crate::table::Cursor;
 
 /// Largest admissible neighbour-search radius [cells].
 pub const MAX_SEARCH_RADIUS: u32 = 1000;
@@ -269,15 +270,17 @@ pub struct MatchResult {
 /// (with neighbour search) the nearest one found ring by ring.
 #[inline]
 fn pair<'a>(
-    dists: &'a Distributions,
+    cursor: &mut Cursor<'a, Gaussian>,
     xw: Vector2<f64>,
     inv_cell: f64,
     options: &MatchOptions,
 ) -> Option<&'a Gaussian> {
     let key = CellKey::of(xw, inv_cell)?;
-    match dists.get(key) {
+    match cursor.get(key) {
         Some(g) => Some(g),
-        None if options.neighbor_search => nearest_in_rings(dists, xw, key, options.search_radius),
+        None if options.neighbor_search => {
+            nearest_in_rings_with(cursor, xw, key, options.search_radius)
+        }
         None => None,
     }
 }
@@ -292,7 +295,8 @@ pub(crate) fn evaluate(
     order: Order,
 ) -> ScoreTerms {
     let sin_cos = pose.theta.sin_cos();
-    let mut terms = ScoreTerms::default();
+    let mut terms = Accumulator::default();
+    let mut cursor = dists.cursor();
     for p in points {
         let x = Vector2::new(p[0], p[1]);
         let xw = pose.transform(x);
@@ -303,7 +307,7 @@ pub(crate) fn evaluate(
             let mut any = false;
             for dy in -1..=1 {
                 for dx in -1..=1 {
-                    if let Some(g) = dists.get(key.offset(dx, dy)) {
+                    if let Some(g) = cursor.get(key.offset(dx, dy)) {
                         terms.add(x, xw, sin_cos, g, order);
                         any = true;
                     }
@@ -314,12 +318,12 @@ pub(crate) fn evaluate(
                 continue;
             }
         }
-        if let Some(g) = pair(dists, xw, inv_cell, options) {
+        if let Some(g) = pair(&mut cursor, xw, inv_cell, options) {
             terms.add(x, xw, sin_cos, g, order);
             terms.matched += 1;
         }
     }
-    terms
+    terms.finish()
 }
 
 impl NdtGrid {

@@ -42,8 +42,71 @@ impl Default for ScoreTerms {
 impl ScoreTerms {
     /// Adds point `x` (scan frame) mapped to `xw = R(θ) x + t` (eq. 2) and
     /// paired with `dist` (the caller counts matched points: a point may be
-    /// paired with several distributions). `(sin θ, cos θ)` are passed in so they are computed
-    /// once per pose, not per point.
+    /// paired with several distributions); see [`Accumulator::add`].
+    #[inline]
+    pub fn add(
+        &mut self,
+        x: Vector2<f64>,
+        xw: Vector2<f64>,
+        sin_cos: (f64, f64),
+        dist: &Gaussian,
+        order: Order,
+    ) {
+        let mut acc = Accumulator::from(*self);
+        acc.add(x, xw, sin_cos, dist, order);
+        *self = acc.finish();
+    }
+}
+
+/// [`ScoreTerms`] being accumulated over a scan: the Hessian's 6 distinct
+/// entries only (it is symmetric), mirrored by [`Accumulator::finish`]. Each
+/// entry is computed by the same expression as the full matrix would be, so
+/// the result is the same to the bit.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Accumulator {
+    /// `E(p)` so far.
+    pub score: f64,
+    gradient: [f64; 3],
+    /// `H₀₀, H₀₁, H₀₂, H₁₁, H₁₂, H₂₂`.
+    hessian: [f64; 6],
+    /// Points that had a reference distribution.
+    pub matched: usize,
+}
+
+impl From<ScoreTerms> for Accumulator {
+    fn from(t: ScoreTerms) -> Self {
+        let h = &t.hessian;
+        Self {
+            score: t.score,
+            gradient: [t.gradient.x, t.gradient.y, t.gradient.z],
+            hessian: [
+                h[(0, 0)],
+                h[(0, 1)],
+                h[(0, 2)],
+                h[(1, 1)],
+                h[(1, 2)],
+                h[(2, 2)],
+            ],
+            matched: t.matched,
+        }
+    }
+}
+
+impl Accumulator {
+    /// The accumulated terms, the Hessian mirrored.
+    pub fn finish(&self) -> ScoreTerms {
+        let h = &self.hessian;
+        ScoreTerms {
+            score: self.score,
+            gradient: Vector3::new(self.gradient[0], self.gradient[1], self.gradient[2]),
+            hessian: Matrix3::new(h[0], h[1], h[2], h[1], h[3], h[4], h[2], h[4], h[5]),
+            matched: self.matched,
+        }
+    }
+
+    /// Adds point `x` (scan frame) mapped to `xw = R(θ) x + t` (eq. 2) and
+    /// paired with `dist`. `(sin θ, cos θ)` are passed in so they are
+    /// computed once per pose, not per point.
     ///
     /// With `d = x' − q`, `C = Σ⁻¹`, `s = exp(−½ dᵀ C d)`,
     /// `J = ∂x'/∂p = [[1, 0, a], [0, 1, b]]`, `a = −x sinθ − y cosθ`,
@@ -83,15 +146,23 @@ impl ScoreTerms {
         let a = -x.x * sn - x.y * cs;
         let b = x.x * cs - x.y * sn;
         // u_k = dᵀ C J_k
-        let u = Vector3::new(cd0, cd1, cd0 * a + cd1 * b);
-        self.gradient += u * s;
+        let u = [cd0, cd1, cd0 * a + cd1 * b];
+        for (g, uk) in self.gradient.iter_mut().zip(u) {
+            *g += uk * s;
+        }
         // J_lᵀ C J_k
         let m02 = c00 * a + c01 * b;
         let m12 = c01 * a + c11 * b;
         let m22 = a * m02 + b * m12;
         // dᵀ C ∂²x'/∂θ²
         let second = cd0 * (-x.x * cs + x.y * sn) + cd1 * (-x.x * sn - x.y * cs);
-        let jcj = Matrix3::new(c00, c01, m02, c01, c11, m12, m02, m12, m22 + second);
-        self.hessian += (jcj - u * u.transpose()) * s;
+        let jcj = [c00, c01, m02, c11, m12, m22 + second];
+        let h = &mut self.hessian;
+        h[0] += (jcj[0] - u[0] * u[0]) * s;
+        h[1] += (jcj[1] - u[0] * u[1]) * s;
+        h[2] += (jcj[2] - u[0] * u[2]) * s;
+        h[3] += (jcj[3] - u[1] * u[1]) * s;
+        h[4] += (jcj[4] - u[1] * u[2]) * s;
+        h[5] += (jcj[5] - u[2] * u[2]) * s;
     }
 }

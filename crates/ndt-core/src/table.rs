@@ -1,0 +1,240 @@
+//! A sparse table of per-cell values stored in dense tiles: the look-up
+//! structure of the matcher's distributions (§III-B keeps cells sparse; the
+//! matcher looks a cell up for every point of every iteration).
+//!
+//! Cells are grouped into square tiles of [`TILE`] × [`TILE`] cells. A hash
+//! map finds a tile by its index; inside a tile a cell is a direct array
+//! access to the slot of its value in one contiguous `Vec`. Consecutive
+//! points of a scan mostly fall into the same tile, so [`Cursor`] remembers
+//! the last tile and skips the hash for them, and the 8 neighbours of the
+//! neighbour search (§IV-A(1)) are mostly in that tile too.
+
+use rustc_hash::FxHashMap;
+
+use crate::key::CellKey;
+
+/// log2 of the tile side [cells].
+const TILE_BITS: i32 = 3;
+/// Tile side [cells]: 8 × 8 cells (16 cm tiles on a 2 cm grid).
+pub const TILE: i32 = 1 << TILE_BITS;
+const MASK: i32 = TILE - 1;
+/// No value in this slot.
+const EMPTY: u32 = u32::MAX;
+
+type Tile = [u32; (TILE * TILE) as usize];
+
+/// Tile index and slot within the tile of `key`.
+#[inline]
+fn split(key: CellKey) -> ((i32, i32), usize) {
+    let tile = (key.ix >> TILE_BITS, key.iy >> TILE_BITS);
+    let slot = ((key.iy & MASK) * TILE + (key.ix & MASK)) as usize;
+    (tile, slot)
+}
+
+/// Values of type `T` keyed by [`CellKey`], in tiles (see the module docs).
+#[derive(Debug, Clone)]
+pub struct CellTable<T> {
+    tiles: FxHashMap<(i32, i32), u32>,
+    slots: Vec<Tile>,
+    /// Occupied tile slots per tile, so empty tiles can be reused.
+    used: Vec<u32>,
+    free_tiles: Vec<u32>,
+    values: Vec<(CellKey, T)>,
+}
+
+impl<T> Default for CellTable<T> {
+    fn default() -> Self {
+        Self {
+            tiles: FxHashMap::default(),
+            slots: Vec::new(),
+            used: Vec::new(),
+            free_tiles: Vec::new(),
+            values: Vec::new(),
+        }
+    }
+}
+
+impl<T> CellTable<T> {
+    /// An empty table with room for about `cells` values.
+    pub fn with_capacity(cells: usize) -> Self {
+        let mut t = Self::default();
+        t.values.reserve(cells);
+        t
+    }
+
+    /// Number of cells with a value.
+    pub fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    /// `true` when no cell has a value.
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+
+    /// The value of `key`, if any.
+    #[inline]
+    pub fn get(&self, key: CellKey) -> Option<&T> {
+        let (tile, slot) = split(key);
+        let t = *self.tiles.get(&tile)?;
+        self.value_at(t, slot)
+    }
+
+    #[inline]
+    fn value_at(&self, tile: u32, slot: usize) -> Option<&T> {
+        let i = self.slots[tile as usize][slot];
+        if i == EMPTY {
+            None
+        } else {
+            Some(&self.values[i as usize].1)
+        }
+    }
+
+    /// Sets the value of `key` (replacing any).
+    pub fn insert(&mut self, key: CellKey, value: T) {
+        let (tile, slot) = split(key);
+        let t = match self.tiles.get(&tile) {
+            Some(&t) => t,
+            None => {
+                let t = match self.free_tiles.pop() {
+                    Some(t) => t,
+                    None => {
+                        self.slots.push([EMPTY; (TILE * TILE) as usize]);
+                        self.used.push(0);
+                        (self.slots.len() - 1) as u32
+                    }
+                };
+                self.tiles.insert(tile, t);
+                t
+            }
+        };
+        let i = &mut self.slots[t as usize][slot];
+        if *i == EMPTY {
+            *i = self.values.len() as u32;
+            self.values.push((key, value));
+            self.used[t as usize] += 1;
+        } else {
+            self.values[*i as usize].1 = value;
+        }
+    }
+
+    /// Removes the value of `key`, if any.
+    pub fn remove(&mut self, key: CellKey) {
+        let (tile, slot) = split(key);
+        let Some(&t) = self.tiles.get(&tile) else {
+            return;
+        };
+        let i = self.slots[t as usize][slot];
+        if i == EMPTY {
+            return;
+        }
+        self.slots[t as usize][slot] = EMPTY;
+        self.used[t as usize] -= 1;
+        if self.used[t as usize] == 0 {
+            self.tiles.remove(&tile);
+            self.free_tiles.push(t);
+        }
+        // Keep the values contiguous: move the last one into the hole.
+        self.values.swap_remove(i as usize);
+        if let Some(&(moved, _)) = self.values.get(i as usize) {
+            let (mt, ms) = split(moved);
+            if let Some(&mt) = self.tiles.get(&mt) {
+                self.slots[mt as usize][ms] = i;
+            }
+        }
+    }
+
+    /// Every `(key, value)`, in no particular order.
+    pub fn iter(&self) -> impl Iterator<Item = (CellKey, &T)> {
+        self.values.iter().map(|(k, v)| (*k, v))
+    }
+
+    /// Bytes this table holds on the heap (capacity, not length): the values,
+    /// the tiles and the tile index.
+    pub fn heap_bytes(&self) -> usize {
+        self.values.capacity() * std::mem::size_of::<(CellKey, T)>()
+            + self.slots.capacity() * std::mem::size_of::<Tile>()
+            + self.used.capacity() * 4
+            + self.free_tiles.capacity() * 4
+            // hashbrown: one control byte per bucket besides the entry.
+            + self.tiles.capacity() * (std::mem::size_of::<((i32, i32), u32)>() + 1)
+    }
+
+    /// A reader that remembers the last tile it used (see [`Cursor`]).
+    #[inline]
+    pub fn cursor(&self) -> Cursor<'_, T> {
+        Cursor {
+            table: self,
+            last: None,
+        }
+    }
+}
+
+/// Reads a [`CellTable`] remembering the last tile looked up, so runs of
+/// look-ups in one tile (a scan's consecutive points, a cell's neighbours)
+/// hash once.
+#[derive(Debug)]
+pub struct Cursor<'a, T> {
+    table: &'a CellTable<T>,
+    last: Option<((i32, i32), Option<u32>)>,
+}
+
+impl<'a, T> Cursor<'a, T> {
+    /// The value of `key`, if any (as [`CellTable::get`]).
+    #[inline]
+    pub fn get(&mut self, key: CellKey) -> Option<&'a T> {
+        let (tile, slot) = split(key);
+        let t = match self.last {
+            Some((k, t)) if k == tile => t,
+            _ => {
+                let t = self.table.tiles.get(&tile).copied();
+                self.last = Some((tile, t));
+                t
+            }
+        };
+        self.table.value_at(t?, slot)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::HashMap;
+
+    #[test]
+    fn matches_a_hash_map_under_inserts_and_removes() {
+        let mut table = CellTable::default();
+        let mut naive = HashMap::new();
+        let mut x: u64 = 7;
+        for step in 0..20_000 {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let key = CellKey {
+                ix: ((x >> 33) % 41) as i32 - 20,
+                iy: ((x >> 13) % 37) as i32 - 18,
+            };
+            if (x >> 60) < 5 {
+                table.remove(key);
+                naive.remove(&key);
+            } else {
+                table.insert(key, step);
+                naive.insert(key, step);
+            }
+        }
+        assert_eq!(table.len(), naive.len());
+        let mut cursor = table.cursor();
+        for ix in -22..22 {
+            for iy in -20..20 {
+                let key = CellKey { ix, iy };
+                assert_eq!(table.get(key), naive.get(&key));
+                assert_eq!(cursor.get(key), naive.get(&key));
+            }
+        }
+        let mut all: Vec<_> = table.iter().map(|(k, v)| (k, *v)).collect();
+        all.sort_unstable();
+        let mut want: Vec<_> = naive.into_iter().collect();
+        want.sort_unstable();
+        assert_eq!(all, want);
+    }
+}
