@@ -35,6 +35,7 @@ pub mod odometry;
 pub mod persist;
 pub mod pyramid;
 pub mod ranges;
+pub mod reduce;
 pub mod score;
 pub mod se2;
 pub mod shape;

@@ -53,7 +53,7 @@ impl ScoreTerms {
         order: Order,
     ) {
         let mut acc = Accumulator::from(*self);
-        acc.add(x, xw, sin_cos, dist, order);
+        acc.add(x, xw, sin_cos, dist, 1.0, order);
         *self = acc.finish();
     }
 }
@@ -105,7 +105,9 @@ impl Accumulator {
     }
 
     /// Adds point `x` (scan frame) mapped to `xw = R(θ) x + t` (eq. 2) and
-    /// paired with `dist`. `(sin θ, cos θ)` are passed in so they are
+    /// paired with `dist`, standing for `weight` scan points (a centroid of
+    /// [`crate::reduce`]; 1 for a point: then the terms are the same to the
+    /// bit as unweighted ones). `(sin θ, cos θ)` are passed in so they are
     /// computed once per pose, not per point.
     ///
     /// With `d = x' − q`, `C = Σ⁻¹`, `s = exp(−½ dᵀ C d)`,
@@ -121,6 +123,7 @@ impl Accumulator {
         xw: Vector2<f64>,
         sin_cos: (f64, f64),
         dist: &Gaussian,
+        weight: f64,
         order: Order,
     ) {
         let d = xw - dist.mean;
@@ -138,6 +141,7 @@ impl Accumulator {
         if s.is_nan() || s <= 0.0 {
             return;
         }
+        let s = weight * s;
         self.score += s;
         if order == Order::Value {
             return;
