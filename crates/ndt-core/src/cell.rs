@@ -158,12 +158,27 @@ impl Gaussian {
         sigma_floor: f64,
         k: f64,
     ) -> Option<Gaussian> {
+        Self::from_shape(own, origin, &Self::shape_of(region, sigma_floor, k)?)
+    }
+
+    /// The covariance part of [`Gaussian::with_shape`] for `region`: a
+    /// distribution whose mean is to be replaced (`None` as there).
+    pub fn shape_of(region: &CellStats, sigma_floor: f64, k: f64) -> Option<Gaussian> {
         if region.count < MIN_POINTS {
             return None;
         }
+        let (q, cov) = region.mean_and_covariance()?;
+        Self::from_moments(q, &cov, sigma_floor, k)
+    }
+
+    /// [`Gaussian::with_shape`] from the region's [`Gaussian::shape_of`]:
+    /// `own`'s mean, `shape`'s inverse covariance and normal (the same bits).
+    pub fn from_shape(own: &CellStats, origin: Vector2<f64>, shape: &Gaussian) -> Option<Gaussian> {
         let (q, _) = own.mean_and_covariance()?;
-        let (_, cov) = region.mean_and_covariance()?;
-        Self::from_moments(origin + q, &cov, sigma_floor, k)
+        Some(Gaussian {
+            mean: origin + q,
+            ..*shape
+        })
     }
 
     /// Regularises covariance `cov` (see [`EIGEN_RATIO`], `sigma_floor`) and

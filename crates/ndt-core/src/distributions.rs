@@ -9,6 +9,7 @@ use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::cell::{CellStats, Gaussian, MIN_POINTS};
 use crate::key::CellKey;
+use crate::pyramid::coarse_key;
 use crate::shape::Shape;
 use crate::table::{CellTable, Cursor};
 
@@ -51,8 +52,9 @@ impl Distributions {
         shape: Option<Shape<'_>>,
     ) -> Self {
         let mut map = CellTable::with_capacity(cells.len());
+        let mut shapes = ShapeCache::default();
         for &key in cells.keys() {
-            if let Some(g) = distribution_of(cells, cell_size, options, shape, key) {
+            if let Some(g) = distribution_of(cells, cell_size, options, shape, &mut shapes, key) {
                 map.insert(key, g);
             }
         }
@@ -101,8 +103,9 @@ impl Distributions {
                 }
             }
         }
+        let mut shapes = ShapeCache::default();
         for key in affected {
-            match distribution_of(cells, cell_size, self.options, shape, key) {
+            match distribution_of(cells, cell_size, self.options, shape, &mut shapes, key) {
                 Some(g) => {
                     self.map.insert(key, g);
                 }
@@ -155,23 +158,32 @@ impl Distributions {
     }
 }
 
+/// The covariance part of each ancestor's shaped distribution
+/// ([`Gaussian::shape_of`]), computed once per ancestor in a build or update
+/// rather than once per fine cell under it.
+type ShapeCache = FxHashMap<CellKey, Option<Gaussian>>;
+
 /// The distribution of one cell under `options`, from the sums alone.
 fn distribution_of(
     cells: &FxHashMap<CellKey, CellStats>,
     cell_size: f64,
     options: DistOptions,
     shape: Option<Shape<'_>>,
+    shapes: &mut ShapeCache,
     key: CellKey,
 ) -> Option<Gaussian> {
     let own = cells.get(&key)?;
     let centre = key.center(cell_size);
     // Own mean, the ancestor's covariance (crate::shape), when the ancestor
-    // has a distribution of its own.
-    if let Some(region) = shape
-        .and_then(|s| s.ancestor(key))
-        .filter(|a| a.count >= MIN_POINTS)
-    {
-        return Gaussian::with_shape(own, centre, region, options.sigma_floor, options.expansion);
+    // has a distribution of its own (Gaussian::with_shape, bit for bit).
+    if let Some(s) = shape {
+        let at = coarse_key(key, s.depth);
+        if let Some(region) = s.cells.get(&at).filter(|a| a.count >= MIN_POINTS) {
+            let covariance = shapes.entry(at).or_insert_with(|| {
+                Gaussian::shape_of(region, options.sigma_floor, options.expansion)
+            });
+            return Gaussian::from_shape(own, centre, covariance.as_ref()?);
+        }
     }
     if own.count >= MIN_POINTS || !options.fuse_minority {
         return Gaussian::from_stats(own, centre, options.sigma_floor, options.expansion);
