@@ -87,7 +87,7 @@ impl Distributions {
     ) {
         let mut affected: FxHashSet<CellKey> = match shape {
             Some(s) => s.descendants_of_touched(cells, touched),
-            None => FxHashSet::default(),
+            None => FxHashSet::with_capacity_and_hasher(touched.len() * 2, Default::default()),
         };
         for &key in touched {
             affected.insert(key);

@@ -102,8 +102,8 @@ impl Pyramid {
     /// Returns, per level, the keys of the cells that changed.
     pub fn add(&mut self, staged: &[(CellKey, Vector2<f64>)]) -> Vec<Vec<CellKey>> {
         let fine = &mut self.levels[0];
-        let mut seen = FxHashSet::default();
-        let mut touched = Vec::new();
+        let mut seen = FxHashSet::with_capacity_and_hasher(staged.len(), Default::default());
+        let mut touched = Vec::with_capacity(staged.len());
         let mut run: Option<(CellKey, CellStats)> = None;
         let mut flush = |key: CellKey, stats: &CellStats| {
             fine.cells.entry(key).or_default().merge(stats);
@@ -144,8 +144,9 @@ impl Pyramid {
         let mut touched_all: Vec<Vec<CellKey>> = Vec::with_capacity(self.levels.len());
         touched_all.push(fine);
         for l in 1..self.levels.len() {
-            let mut parents = FxHashSet::default();
-            let mut changed = Vec::new();
+            let below = touched_all[l - 1].len();
+            let mut parents = FxHashSet::with_capacity_and_hasher(below, Default::default());
+            let mut changed = Vec::with_capacity(below);
             for &child in &touched_all[l - 1] {
                 let parent = coarse_key(child, 1);
                 if parents.insert(parent) {

@@ -56,7 +56,7 @@ impl<'a> Shape<'a> {
                 .copied()
                 .collect();
         }
-        let mut out = FxHashSet::default();
+        let mut out = FxHashSet::with_capacity_and_hasher(touched.len() * 4, Default::default());
         let side = side as i32; // < 2^16 here: side² < cells.len()
         for a in ancestors {
             // The ancestor's square of `side × side` cells on this level.
