@@ -1,9 +1,13 @@
-//! `cargo bench`: insert and match of 180-, 361- and 683-point scans on 2 cm
-//! and 20 cm grids (one core, one thread).
+//! `cargo bench`: insert and match of 180-, 361-, 683- and 2000-point scans
+//! on 2 cm and 20 cm grids, and the pyramid update alone (one core, one
+//! thread; throughput in scan points).
 //!
 //! The map is the synthetic room of the tests, built from eight scans; the
 //! matched scan is taken 3 cm / 1° away from its guess. `match` uses the
 //! default options (pyramid), `match_paper` the paper's method alone.
+//! `insert` keeps the prepared distributions of a default match up to date
+//! (as in a SLAM loop), `insert_sums_only` has none prepared (eq. 6 and the
+//! pyramid's sums only), `pyramid_update` is the pyramid's part of that.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -11,13 +15,16 @@ mod common;
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use ndt_core::{MatchOptions, NdtGrid, Pose2};
+use ndt_core::grid::DEFAULT_LEVELS;
+use ndt_core::nalgebra::Vector2;
+use ndt_core::pyramid::Pyramid;
+use ndt_core::{CellKey, MatchOptions, NdtGrid, Pose2};
 
-const BEAMS: [usize; 3] = [180, 361, 683];
+const BEAMS: [usize; 4] = [180, 361, 683, 2000];
 const CELLS: [f64; 2] = [0.02, 0.2];
 
 fn scan(beams: usize, pose: Pose2, seed: u64) -> Vec<[f64; 2]> {
-    let fov = if beams == 683 { 240f64 } else { 180f64 };
+    let fov = if beams >= 683 { 240f64 } else { 180f64 };
     common::scan(&common::room(), pose, beams, fov.to_radians(), 0.01, seed)
 }
 
@@ -33,7 +40,13 @@ fn map(beams: usize, cell: f64) -> NdtGrid {
 }
 
 fn bench_insert(c: &mut Criterion) {
-    let mut group = c.benchmark_group("insert");
+    for (name, prepared) in [("insert", true), ("insert_sums_only", false)] {
+        bench_insert_with(c, name, prepared);
+    }
+}
+
+fn bench_insert_with(c: &mut Criterion, name: &str, prepared: bool) {
+    let mut group = c.benchmark_group(name);
     for cell in CELLS {
         for beams in BEAMS {
             let grid = map(beams, cell);
@@ -41,7 +54,9 @@ fn bench_insert(c: &mut Criterion) {
             let pts = scan(beams, pose, 42);
             // A SLAM loop's map has its distributions built: insert keeps them
             // up to date, and that is part of what is timed.
-            let _ = grid.match_scan(&pts, pose, &MatchOptions::default());
+            if prepared {
+                let _ = grid.match_scan(&pts, pose, &MatchOptions::default());
+            }
             group.throughput(Throughput::Elements(pts.len() as u64));
             group.bench_with_input(
                 BenchmarkId::new(format!("cell_{}cm", cell * 100.0), beams),
@@ -57,6 +72,48 @@ fn bench_insert(c: &mut Criterion) {
         }
     }
     group.finish();
+}
+
+/// `Pyramid::add` alone: eq. (6) on the fine level and the coarser levels
+/// re-summed above the changed cells (6 levels).
+fn bench_pyramid(c: &mut Criterion) {
+    let mut group = c.benchmark_group("pyramid_update");
+    for cell in CELLS {
+        for beams in BEAMS {
+            let mut pyramid = Pyramid::new(cell, DEFAULT_LEVELS);
+            for i in 0..8u32 {
+                let a = f64::from(i) * 0.8;
+                let pose = Pose2::new(0.3 * a.cos(), 0.2 * a.sin(), a);
+                pyramid.add(&staged(&scan(beams, pose, u64::from(i)), pose, cell));
+            }
+            let pose = Pose2::new(0.1, -0.05, 0.3);
+            let batch = staged(&scan(beams, pose, 42), pose, cell);
+            group.throughput(Throughput::Elements(batch.len() as u64));
+            group.bench_with_input(
+                BenchmarkId::new(format!("cell_{}cm", cell * 100.0), beams),
+                &batch,
+                |b, batch| {
+                    b.iter_batched_ref(
+                        || pyramid.clone(),
+                        |p| p.add(black_box(batch)),
+                        criterion::BatchSize::LargeInput,
+                    )
+                },
+            );
+        }
+    }
+    group.finish();
+}
+
+/// Map-frame points with their fine keys, as `NdtGrid::insert` stages them.
+fn staged(points: &[[f64; 2]], pose: Pose2, cell: f64) -> Vec<(CellKey, Vector2<f64>)> {
+    points
+        .iter()
+        .filter_map(|p| {
+            let w = pose.transform(Vector2::new(p[0], p[1]));
+            CellKey::of(w, 1.0 / cell).map(|k| (k, w))
+        })
+        .collect()
 }
 
 /// The paper's method alone (§IV-A on the fine grid only).
@@ -91,5 +148,5 @@ fn bench_match_with(c: &mut Criterion, name: &str, options: &MatchOptions) {
     group.finish();
 }
 
-criterion_group!(benches, bench_insert, bench_match);
+criterion_group!(benches, bench_insert, bench_pyramid, bench_match);
 criterion_main!(benches);

@@ -10,7 +10,7 @@ mod common;
 
 use std::hint::black_box;
 
-use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use ndt_core::{Odometry, OdometryConfig, Pose2};
 
 fn polar(pose: Pose2, seed: u64) -> (Vec<f64>, Vec<f64>) {
@@ -39,13 +39,16 @@ fn bench_step(c: &mut Criterion) {
     }
     let (r, a) = polar(path(60), 60);
     let odom = path(60).compose(Pose2::new(0.0, 0.0, 0.12));
-    c.bench_function("odometry_step_181_beams_2cm", |b| {
+    let mut group = c.benchmark_group("odometry_step");
+    group.throughput(Throughput::Elements(r.len() as u64));
+    group.bench_function("181_beams_2cm", |b| {
         b.iter_batched_ref(
             || odo.clone(),
             |o| o.step(black_box(&r), black_box(&a), Some(odom)),
             BatchSize::LargeInput,
         )
     });
+    group.finish();
 }
 
 criterion_group!(benches, bench_step);
