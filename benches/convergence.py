@@ -72,7 +72,9 @@ def urg_pairs(count: int) -> Iterator[Pair]:
         print("skipped the URG-04LX log: ../shared/data/real absent")
         return
     scans = list(read_mines(log))
-    judges = [p for p in peer_lib.all_peers() if "GICP (" in p.name or "plane" in p.name]
+    judges = [
+        p for p in peer_lib.all_peers() if p.name.startswith("small_gicp GICP") or "plane" in p.name
+    ]
     for k in np.linspace(0, len(scans) - 4, count).astype(int):
         a, b = scans[k], scans[k + 3]
         pa, pb = a.points(max_range=4.0), b.points(max_range=4.0)
