@@ -555,6 +555,23 @@ impl NdtGrid {
         pose: Pose2,
         options: &MatchOptions,
     ) -> Result<ScoreTerms> {
+        self.terms_at(points, pose, options, Order::Derivatives)
+    }
+
+    /// `E(p)` of eq. (1) alone for `points` at `pose` (the same value as
+    /// [`NdtGrid::score_terms`]'s, without the derivatives' cost): for
+    /// comparing candidate poses.
+    pub fn score(&self, points: &[[f64; 2]], pose: Pose2, options: &MatchOptions) -> Result<f64> {
+        Ok(self.terms_at(points, pose, options, Order::Value)?.score)
+    }
+
+    fn terms_at(
+        &self,
+        points: &[[f64; 2]],
+        pose: Pose2,
+        options: &MatchOptions,
+        order: Order,
+    ) -> Result<ScoreTerms> {
         options.validate()?;
         check_finite("pose", &pose.to_array())?;
         check_points("points", points)?;
@@ -568,7 +585,7 @@ impl NdtGrid {
             pose,
             self.inv_cell_size(),
             options,
-            Order::Derivatives,
+            order,
         ))
     }
 }

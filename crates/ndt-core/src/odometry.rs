@@ -332,11 +332,7 @@ impl Odometry {
         if range <= 0.0 {
             return Ok(prediction);
         }
-        let score = |p: Pose2| {
-            self.grid()
-                .score_terms(points, p, &self.config.matcher)
-                .map(|t| t.score)
-        };
+        let score = |p: Pose2| self.grid().score(points, p, &self.config.matcher);
         let mut best = (score(prediction)?, prediction);
         let n = (range / step).floor() as i64;
         for i in (-n..=n).filter(|&i| i != 0) {
