@@ -224,7 +224,10 @@ class NdtGrid:
         rotation_search : float, default 0.15
             Half-width [rad] of the rotational multi-start of the first
             (coarsest) stage: it also solves from the guess turned by +/- this
-            angle and keeps the best score; 0 turns it off.
+            angle and keeps the best score; 0 turns it off. Above the fine
+            level the turned starts are first solved on centroids of runs of
+            scan points (voxels half the coarsest cell), and solved on every
+            point only when they land above the best score so far.
         freeze_unconstrained : bool, default True
             From the second pyramid stage on, project Newton steps onto the
             pose directions the scan constrains well (point-to-plane information:

@@ -108,7 +108,8 @@ pub struct MatchOptions {
     /// Half-width [rad] of the rotational multi-start of the first stage: it
     /// also solves from the guess turned by ± this angle and keeps the best
     /// score (0 = off). Measured on real pairs with ±10° starts: 65 % success
-    /// without, 70 % with 0.15 rad.
+    /// without, 70 % with 0.15 rad. Above the fine level the turned starts
+    /// are first solved on run centroids (see [`CANDIDATE_VOXEL`]).
     pub rotation_search: f64,
     /// Keep the pose where the previous stage put it along directions the
     /// scan does not constrain (a corridor's axis), instead of letting fine
