@@ -61,7 +61,7 @@ fn scan(walls: &[common::Segment], k: u64) -> (Vec<f64>, Vec<f64>) {
     (r, a)
 }
 
-/// `(VmRSS, VmHWM)` of this process [KiB].
+/// `(VmRSS, VmHWM)` of this process \[KiB\].
 fn memory_kib() -> (u64, u64) {
     let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
     let field = |name: &str| {

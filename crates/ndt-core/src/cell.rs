@@ -9,7 +9,7 @@ use nalgebra::{Matrix2, Vector2};
 /// the large one.
 pub const EIGEN_RATIO: f64 = 0.01;
 
-/// Default smallest standard deviation of a cell's distribution [m], before
+/// Default smallest standard deviation of a cell's distribution \[m\], before
 /// the expansion of eq. (8) (see `MatchOptions::sigma_floor`). A cell whose
 /// points coincide would otherwise have a zero covariance, and a distribution
 /// narrower than the scatter between two scans of the same surface (range
@@ -46,14 +46,14 @@ pub const MIN_POINTS: u64 = 3;
 pub struct CellStats {
     /// `M`: number of points.
     pub count: u64,
-    /// `m`: sum of the points about the origin [m].
+    /// `m`: sum of the points about the origin \[m\].
     pub sum: Vector2<f64>,
-    /// `S`: sum of outer products about the origin [m²] (symmetric).
+    /// `S`: sum of outer products about the origin \[m²\] (symmetric).
     pub scatter: Matrix2<f64>,
 }
 
 impl CellStats {
-    /// eq. (6) for one point `x − o` [m].
+    /// eq. (6) for one point `x − o` \[m\].
     #[inline]
     pub fn add_point(&mut self, d: Vector2<f64>) {
         self.count += 1;
@@ -115,9 +115,9 @@ pub fn symmetric_eigen2(m: &Matrix2<f64>) -> (f64, f64, Vector2<f64>) {
 /// (kept compact: this is what the matcher's inner loop reads).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Gaussian {
-    /// `q` of eq. (7), map frame [m].
+    /// `q` of eq. (7), map frame \[m\].
     pub mean: Vector2<f64>,
-    /// `Σ'⁻¹` [1/m²], with `Σ' = V diag(kλ₁, kλ₂) Vᵀ` of eq. (8).
+    /// `Σ'⁻¹` \[1/m²\], with `Σ' = V diag(kλ₁, kλ₂) Vᵀ` of eq. (8).
     pub inverse: Matrix2<f64>,
     /// Unit normal: the direction of least spread of the eq. (7) covariance
     /// before regularisation. The σ floor can make `Σ'` of a small cell
@@ -129,7 +129,7 @@ pub struct Gaussian {
 impl Gaussian {
     /// eq. (7) from statistics about `origin`, regularised (small eigenvalue
     /// at least [`EIGEN_RATIO`] of the large one, both standard deviations at
-    /// least `sigma_floor` [m], see [`DEFAULT_SIGMA_FLOOR`]) and expanded by
+    /// least `sigma_floor` \[m\], see [`DEFAULT_SIGMA_FLOOR`]) and expanded by
     /// `k` (eq. 8: both eigenvalues times `k`, eigenvectors kept). `None`
     /// below [`MIN_POINTS`] points, and when `k` or `sigma_floor` is so
     /// extreme that `Σ'⁻¹` is not finite.
@@ -209,7 +209,7 @@ impl Gaussian {
         })
     }
 
-    /// `Σ'` [m²]: the regularised, expanded covariance (eq. 8).
+    /// `Σ'` \[m²\]: the regularised, expanded covariance (eq. 8).
     pub fn covariance(&self) -> Matrix2<f64> {
         let c = &self.inverse;
         let det = c[(0, 0)] * c[(1, 1)] - c[(0, 1)] * c[(1, 0)];

@@ -24,7 +24,7 @@ pub const DEGENERACY_RATIO: f64 = 0.02;
 pub const FREEZE_RATIO: f64 = 0.1;
 
 /// Unit directions `(dx, dy, L·dθ)` (rotation expressed as the arc length at
-/// lever arm `length` [m]) along which the information (or Hessian) matrix `h`
+/// lever arm `length` \[m\]) along which the information (or Hessian) matrix `h`
 /// (order `x, y, θ`) has an eigenvalue below [`DEGENERACY_RATIO`] times its
 /// largest.
 /// Scaling rotation by the scan's lever arm makes the three axes comparable:

@@ -22,10 +22,10 @@ pub struct DistOptions {
     /// §IV-A(3): a cell with fewer than 3 points takes the distribution of the
     /// summed eq. (6) terms of itself and its 8 neighbours.
     pub fuse_minority: bool,
-    /// Smallest standard deviation of a distribution before expansion [m]
+    /// Smallest standard deviation of a distribution before expansion \[m\]
     /// (see [`crate::cell::DEFAULT_SIGMA_FLOOR`]).
     pub sigma_floor: f64,
-    /// Cells finer than this [m] take the covariance of their ancestor of
+    /// Cells finer than this \[m\] take the covariance of their ancestor of
     /// (at least) this size ([`crate::shape`]); 0 = off.
     pub shape_cell: f64,
 }
@@ -124,7 +124,7 @@ impl Distributions {
         self.level
     }
 
-    /// Cell size [m].
+    /// Cell size \[m\].
     pub fn cell_size(&self) -> f64 {
         self.cell_size
     }

@@ -29,11 +29,11 @@ pub enum NdtError {
         what: &'static str,
         /// Index of the point.
         index: usize,
-        /// Map-frame x of the point [m].
+        /// Map-frame x of the point \[m\].
         x: f64,
-        /// Map-frame y of the point [m].
+        /// Map-frame y of the point \[m\].
         y: f64,
-        /// Largest admissible |coordinate| [m].
+        /// Largest admissible |coordinate| \[m\].
         limit: f64,
     },
     /// An input that must hold at least one element held none.

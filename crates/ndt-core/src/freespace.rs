@@ -34,9 +34,9 @@ pub struct FreeSpace {
 /// [`OCCUPIED`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Raster {
-    /// Map-frame position of the outer corner of cell (0, 0) (lowest x and y) [m].
+    /// Map-frame position of the outer corner of cell (0, 0) (lowest x and y) \[m\].
     pub origin: [f64; 2],
-    /// Side of a cell [m].
+    /// Side of a cell \[m\].
     pub resolution: f64,
     /// Columns (along x).
     pub width: usize,
@@ -63,7 +63,7 @@ impl FreeSpace {
         })
     }
 
-    /// Cell size [m].
+    /// Cell size \[m\].
     pub fn resolution(&self) -> f64 {
         self.resolution
     }
@@ -90,7 +90,7 @@ impl FreeSpace {
     }
 
     /// Adds the beams of a scan: from the sensor at `pose` (`T_map_scan`) to
-    /// each scan-frame point [m], every cell the beam passes through counts
+    /// each scan-frame point \[m\], every cell the beam passes through counts
     /// one beam, except the cell of the hit itself. All-or-nothing: on error
     /// (non-finite input, a coordinate beyond the lattice) nothing changes.
     pub fn add_scan(&mut self, points: &[[f64; 2]], pose: Pose2) -> Result<()> {
@@ -158,7 +158,7 @@ impl FreeSpace {
     }
 
     /// A dense image covering every crossed cell and every `occupied`
-    /// map-frame point [m] (e.g. the NDT map's occupied cell centres): cells
+    /// map-frame point \[m\] (e.g. the NDT map's occupied cell centres): cells
     /// holding a point are [`OCCUPIED`], other crossed cells [`FREE`], the
     /// rest [`UNKNOWN`].
     ///

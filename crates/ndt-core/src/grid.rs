@@ -34,9 +34,9 @@ pub struct CellRecord {
     pub key: CellKey,
     /// `M` of eq. (6).
     pub count: u64,
-    /// `m = Σ x` in map coordinates [m].
+    /// `m = Σ x` in map coordinates \[m\].
     pub sum: Vector2<f64>,
-    /// `S = Σ x xᵀ` in map coordinates [m²].
+    /// `S = Σ x xᵀ` in map coordinates \[m²\].
     pub scatter: Matrix2<f64>,
 }
 
@@ -117,12 +117,12 @@ impl NdtGrid {
         self.pyramid.fine().cells()
     }
 
-    /// Cell size [m].
+    /// Cell size \[m\].
     pub fn cell_size(&self) -> f64 {
         self.cell_size
     }
 
-    /// 1 / cell size [1/m].
+    /// 1 / cell size \[1/m\].
     pub(crate) fn inv_cell_size(&self) -> f64 {
         self.inv_cell_size
     }
@@ -137,7 +137,7 @@ impl NdtGrid {
         self.fine().is_empty()
     }
 
-    /// Largest |map coordinate| a point may have [m].
+    /// Largest |map coordinate| a point may have \[m\].
     pub fn coordinate_limit(&self) -> f64 {
         f64::from(MAX_INDEX) * self.cell_size
     }
@@ -168,7 +168,7 @@ impl NdtGrid {
         out
     }
 
-    /// eq. (6): adds the scan-frame `points` [m] seen from `pose`
+    /// eq. (6): adds the scan-frame `points` \[m\] seen from `pose`
     /// (`T_map_scan`) to the grid. All-or-nothing: on error (non-finite input,
     /// a point whose cell index would overflow) the grid is unchanged.
     ///
@@ -278,7 +278,7 @@ impl NdtGrid {
 }
 
 /// Levels from `level` up to the first level whose cells are at least
-/// `shape_cell` [m] (see [`crate::shape`]); 0 when `shape_cell` is 0 or no
+/// `shape_cell` \[m\] (see [`crate::shape`]); 0 when `shape_cell` is 0 or no
 /// coarser level is that large.
 fn shape_depth(pyramid: &Pyramid, level: usize, shape_cell: f64) -> usize {
     if shape_cell <= 0.0 {

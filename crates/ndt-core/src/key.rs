@@ -32,7 +32,7 @@ pub struct CellKey {
 }
 
 impl CellKey {
-    /// The key of the cell holding `p` [m], or `None` when the index would
+    /// The key of the cell holding `p` \[m\], or `None` when the index would
     /// exceed ±[`MAX_INDEX`] (or `p` is not finite).
     #[inline]
     pub fn of(p: Vector2<f64>, inv_cell_size: f64) -> Option<CellKey> {
@@ -42,7 +42,7 @@ impl CellKey {
         })
     }
 
-    /// Centre of the cell [m].
+    /// Centre of the cell \[m\].
     #[inline]
     pub fn center(self, cell_size: f64) -> Vector2<f64> {
         Vector2::new(

@@ -18,7 +18,7 @@ use crate::se2::Pose2;
 use crate::solver::{covariance_from_hessian, minimise, SolverOptions};
 use crate::table::Cursor;
 
-/// Largest admissible neighbour-search radius [cells].
+/// Largest admissible neighbour-search radius \[cells\].
 pub const MAX_SEARCH_RADIUS: u32 = 1000;
 
 /// Pyramid levels summed in one coarse-to-fine stage: the stage's own level
@@ -29,7 +29,7 @@ pub const MAX_SEARCH_RADIUS: u32 = 1000;
 /// with a window of 2, 78 % / 73 % with 3.
 pub const LEVEL_WINDOW: usize = 2;
 
-/// Default [`MatchOptions::shape_cell`] [m]: fine cells take the covariance
+/// Default [`MatchOptions::shape_cell`] \[m\]: fine cells take the covariance
 /// of the 32 cm cell they lie in (16 × 16 fine cells of 2 cm). Measured with
 /// the default match on the SICK pairs of `benches/convergence.py` (success,
 /// local / wide starts; benchmark pairs | held-out pairs): off 81.5 / 79.6 |
@@ -39,7 +39,7 @@ pub const LEVEL_WINDOW: usize = 2;
 /// and 76.7 / 74.3 %, 32 cm 76.4 / 74.9 and 79.5 / 78.3 %.
 pub const DEFAULT_SHAPE_CELL: f64 = 0.32;
 
-/// Largest coarsest-level cell [m] of the automatic level count: the coarse
+/// Largest coarsest-level cell \[m\] of the automatic level count: the coarse
 /// stage must still see a room's walls as separate structures.
 pub const AUTO_COARSEST_CELL: f64 = 0.64;
 
@@ -70,13 +70,13 @@ pub const CANDIDATE_VOXEL: f64 = 0.5;
 pub struct MatchOptions {
     /// `k` of eq. (8) (> 0; 1 = no expansion).
     pub expansion: f64,
-    /// Smallest standard deviation [m] a cell's distribution is given before
+    /// Smallest standard deviation \[m\] a cell's distribution is given before
     /// the expansion (> 0): the scatter between two scans of one surface
     /// (range noise, beam footprint, sampling). Default
     /// [`DEFAULT_SIGMA_FLOOR`] (1 cm), chosen by measurement (see there);
     /// lower it for a more precise sensor.
     pub sigma_floor: f64,
-    /// Cells finer than this [m] take the covariance shape of their ancestor
+    /// Cells finer than this \[m\] take the covariance shape of their ancestor
     /// of at least this size, around their own mean ([`crate::shape`]): the
     /// wall segment they lie on, so fine cells constrain a scan across a
     /// surface, not along it. 0 = off (the paper's distributions). Default
@@ -85,7 +85,7 @@ pub struct MatchOptions {
     /// §IV-A(1): pair points whose own cell has no distribution with a nearby
     /// cell's (see [`crate::neighbor::nearest_in_rings`]).
     pub neighbor_search: bool,
-    /// Neighbour-search radius [cells] (Chebyshev distance), ≤ [`MAX_SEARCH_RADIUS`].
+    /// Neighbour-search radius \[cells\] (Chebyshev distance), ≤ [`MAX_SEARCH_RADIUS`].
     pub search_radius: u32,
     /// §IV-A(3): fuse cells with fewer than 3 points with their neighbours.
     pub fuse_minority: bool,
@@ -96,16 +96,16 @@ pub struct MatchOptions {
     pub pair_neighbors: bool,
     /// Newton iterations at most.
     pub max_iterations: u32,
-    /// Convergence threshold on the translation step [m].
+    /// Convergence threshold on the translation step \[m\].
     pub translation_tolerance: f64,
-    /// Convergence threshold on the rotation step [rad].
+    /// Convergence threshold on the rotation step \[rad\].
     pub rotation_tolerance: f64,
-    /// Largest translation per Newton step [cells]. With 2 cm cells a long
+    /// Largest translation per Newton step \[cells\]. With 2 cm cells a long
     /// step jumps past the narrow basin (§IV-A); 2 cells keeps it inside.
     pub max_step_cells: f64,
-    /// Largest rotation per Newton step [rad].
+    /// Largest rotation per Newton step \[rad\].
     pub max_step_rotation: f64,
-    /// Half-width [rad] of the rotational multi-start of the first stage: it
+    /// Half-width \[rad\] of the rotational multi-start of the first stage: it
     /// also solves from the guess turned by ± this angle and keeps the best
     /// score (0 = off). Measured on real pairs with ±10° starts: 65 % success
     /// without, 70 % with 0.15 rad. Above the fine level the turned starts
@@ -118,7 +118,7 @@ pub struct MatchOptions {
     /// information (see [`crate::degeneracy::constrained_projector`]).
     pub freeze_unconstrained: bool,
     /// With `freeze_unconstrained`: a direction is frozen when its curvature
-    /// is below this fraction of the strongest (in [0, 1]; default
+    /// is below this fraction of the strongest (in \[0, 1\]; default
     /// [`crate::degeneracy::FREEZE_RATIO`]).
     pub freeze_ratio: f64,
     /// Pyramid levels to match on, coarse to fine (1 = the fine grid only,
@@ -370,7 +370,7 @@ fn stack_terms(
 }
 
 impl NdtGrid {
-    /// Matches scan-frame `points` [m] against the grid from `guess`
+    /// Matches scan-frame `points` \[m\] against the grid from `guess`
     /// (`T_map_scan`) by Newton's method on eq. (1).
     ///
     /// Errors on empty or non-finite input, on points beyond

@@ -27,7 +27,7 @@ use crate::matcher::{MatchOptions, MatchResult};
 use crate::ranges::points_from_ranges;
 use crate::se2::Pose2;
 
-/// σ floor [m] of the loop's matcher (see [`OdometryConfig::matcher`]).
+/// σ floor \[m\] of the loop's matcher (see [`OdometryConfig::matcher`]).
 pub const ODOMETRY_SIGMA_FLOOR: f64 = 0.005;
 
 /// Most rotations tried on each side of the prediction by the rotation search.
@@ -36,17 +36,17 @@ const MAX_ROTATION_CANDIDATES: f64 = 1000.0;
 /// Settings of the loop. Units: metres and radians.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OdometryConfig {
-    /// Side of the map's square cells [m].
+    /// Side of the map's square cells \[m\].
     pub cell_size: f64,
-    /// Beams shorter than this are skipped [m].
+    /// Beams shorter than this are skipped \[m\].
     pub min_range: f64,
     /// Beams at or beyond this are skipped ("no return", or too far to be
-    /// worth a 2 cm cell) [m].
+    /// worth a 2 cm cell) \[m\].
     pub max_range: f64,
     /// A scan is added to the map when the pose moved at least this far since
-    /// the last added scan [m]…
+    /// the last added scan \[m\]…
     pub insert_distance: f64,
-    /// …or turned at least this much [rad].
+    /// …or turned at least this much \[rad\].
     pub insert_angle: f64,
     /// The map keeps the cells hit by the last `map_window` added scans
     /// (0 = keep every cell; see the module's memory bound).
@@ -56,20 +56,20 @@ pub struct OdometryConfig {
     /// the prediction. In `[0, 1]`.
     pub min_match_ratio: f64,
     /// Half-width of the search over the predicted rotation before matching
-    /// [rad] (0 = off): the score of eq. (1) is evaluated at the prediction
+    /// \[rad\] (0 = off): the score of eq. (1) is evaluated at the prediction
     /// turned by `±rotation_step, ±2·rotation_step, …` up to this, and Newton
     /// starts from the best. A 2 cm map's basin is narrow in rotation (1° moves
     /// a point 5 m away by 9 cm), and wheel odometry is worst in turns.
     pub rotation_search: f64,
-    /// Step of that search [rad].
+    /// Step of that search \[rad\].
     pub rotation_step: f64,
     /// When the odometry prior and the constant-velocity prior differ by at
-    /// least this translation [m] (or [`OdometryConfig::prior_gap_angle`]),
+    /// least this translation \[m\] (or [`OdometryConfig::prior_gap_angle`]),
     /// the scan is matched from both and the match with the higher score of
     /// eq. (1) is kept. (The constant-velocity prior is also tried whenever
     /// the match from the odometry prior fails.) `inf` = never; 0 = always.
     pub prior_gap_distance: f64,
-    /// The rotation of that gap [rad].
+    /// The rotation of that gap \[rad\].
     pub prior_gap_angle: f64,
     /// The matcher's options (§IV-A). The loop's default differs from the
     /// paper's in one place: `expansion` (`k` of eq. 8) is 30, not 10 —
@@ -349,7 +349,7 @@ impl Odometry {
         Ok(best.1)
     }
 
-    /// Processes one scan: `ranges` [m] and `angles` [rad] of its beams in the
+    /// Processes one scan: `ranges` \[m\] and `angles` \[rad\] of its beams in the
     /// sensor frame, and optionally the odometry pose of the sensor at the
     /// scan. Returns the pose and what was done.
     ///

@@ -21,7 +21,7 @@ pub struct Level {
 }
 
 impl Level {
-    /// Cell size of this level [m].
+    /// Cell size of this level \[m\].
     pub fn cell_size(&self) -> f64 {
         self.cell_size
     }

@@ -14,7 +14,7 @@ pub fn check_beams(ranges: &[f64], angles: &[f64]) -> Result<()> {
     check_finite("angles", angles)
 }
 
-/// Scan-frame points `(r cos a, r sin a)` [m] of the beams whose range is
+/// Scan-frame points `(r cos a, r sin a)` \[m\] of the beams whose range is
 /// valid: finite and `min_range ≤ r < max_range` (so 0, NaN, ∞ and readings at
 /// the sensor's maximum, which mean "no return", are skipped).
 ///

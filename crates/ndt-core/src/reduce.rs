@@ -16,7 +16,7 @@ use crate::key::CellKey;
 /// Points with weights: `points[i]` stands for `weights[i]` scan points.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Weighted {
-    /// Centroids (scan frame) [m].
+    /// Centroids (scan frame) \[m\].
     pub points: Vec<[f64; 2]>,
     /// Number of scan points each centroid stands for.
     pub weights: Vec<f64>,
@@ -35,7 +35,7 @@ impl Weighted {
 }
 
 /// Merges runs of consecutive `points` that fall into the same square voxel
-/// of side `voxel` [m] (voxels aligned with the scan frame's origin) into
+/// of side `voxel` \[m\] (voxels aligned with the scan frame's origin) into
 /// their centroid, weighted by the run length. `voxel ≤ 0` (or not finite)
 /// keeps every point with weight 1.
 pub fn voxel_runs(points: &[[f64; 2]], voxel: f64) -> Weighted {

@@ -20,7 +20,7 @@ pub enum Order {
 pub struct ScoreTerms {
     /// `E(p) = Σᵢ exp(−½ dᵢᵀ Σᵢ⁻¹ dᵢ)` over paired points (eq. 1).
     pub score: f64,
-    /// `g = ∇(−E)` [1/m, 1/m, 1/rad].
+    /// `g = ∇(−E)` \[1/m, 1/m, 1/rad\].
     pub gradient: Vector3<f64>,
     /// `H = ∇²(−E)`.
     pub hessian: Matrix3<f64>,

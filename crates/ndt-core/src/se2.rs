@@ -8,15 +8,15 @@ use crate::error::{check_finite, Result};
 /// `x' = R(θ) x + t`. Translation in metres, rotation in radians.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Pose2 {
-    /// Translation along the map's x axis [m].
+    /// Translation along the map's x axis \[m\].
     pub x: f64,
-    /// Translation along the map's y axis [m].
+    /// Translation along the map's y axis \[m\].
     pub y: f64,
-    /// Rotation [rad]; kept wrapped to (−π, π] by the constructors.
+    /// Rotation \[rad\]; kept wrapped to (−π, π] by the constructors.
     pub theta: f64,
 }
 
-/// Wraps an angle to (−π, π] [rad].
+/// Wraps an angle to (−π, π] \[rad\].
 pub fn wrap_angle(theta: f64) -> f64 {
     let two_pi = 2.0 * std::f64::consts::PI;
     let mut a = theta.rem_euclid(two_pi);
@@ -64,7 +64,7 @@ impl Pose2 {
         Matrix3::new(c, -s, self.x, s, c, self.y, 0.0, 0.0, 1.0)
     }
 
-    /// eq. (2): `x' = R(θ) x + t` [m].
+    /// eq. (2): `x' = R(θ) x + t` \[m\].
     #[inline]
     pub fn transform(self, p: Vector2<f64>) -> Vector2<f64> {
         let (s, c) = self.theta.sin_cos();

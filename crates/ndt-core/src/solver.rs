@@ -10,8 +10,8 @@
 //! 3. a backtracking line search halves the step (at most 12 times) until
 //!    `f` decreases by the Armijo condition `f(p + αΔp) ≤ f(p) + 1e-4 α gᵀΔp`.
 //!
-//! Convergence (`converged = true`): a step below `translation_tolerance` [m]
-//! and `rotation_tolerance` [rad] — the full Newton step, the step the line
+//! Convergence (`converged = true`): a step below `translation_tolerance` \[m\]
+//! and `rotation_tolerance` \[rad\] — the full Newton step, the step the line
 //! search accepted, or the largest step it tried without finding a decrease
 //! (a local optimum of the piecewise-smooth score at that resolution).
 //! Running out of iterations or losing every paired point end the solve with
@@ -32,13 +32,13 @@ const EIGEN_FLOOR: f64 = 1e-9;
 pub struct SolverOptions {
     /// Newton iterations at most.
     pub max_iterations: u32,
-    /// Convergence threshold on the translation step [m].
+    /// Convergence threshold on the translation step \[m\].
     pub translation_tolerance: f64,
-    /// Convergence threshold on the rotation step [rad].
+    /// Convergence threshold on the rotation step \[rad\].
     pub rotation_tolerance: f64,
-    /// Largest translation per iteration [m].
+    /// Largest translation per iteration \[m\].
     pub max_step_translation: f64,
-    /// Largest rotation per iteration [rad].
+    /// Largest rotation per iteration \[rad\].
     pub max_step_rotation: f64,
     /// Steps are multiplied by this matrix before use: the identity, or a
     /// projection that removes the directions a scan does not constrain

@@ -13,9 +13,9 @@ use rustc_hash::FxHashMap;
 
 use crate::key::CellKey;
 
-/// log2 of the tile side [cells].
+/// log2 of the tile side \[cells\].
 const TILE_BITS: i32 = 3;
-/// Tile side [cells]: 8 × 8 cells (16 cm tiles on a 2 cm grid).
+/// Tile side \[cells\]: 8 × 8 cells (16 cm tiles on a 2 cm grid).
 pub const TILE: i32 = 1 << TILE_BITS;
 const MASK: i32 = TILE - 1;
 /// No value in this slot.

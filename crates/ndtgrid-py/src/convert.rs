@@ -17,7 +17,7 @@ pub struct Points<'py> {
 }
 
 impl Points<'_> {
-    /// The points as `[x, y]` pairs [m].
+    /// The points as `[x, y]` pairs \[m\].
     pub fn as_pairs(&self) -> PyResult<&[[f64; 2]]> {
         let flat = self
             .array

@@ -35,7 +35,7 @@ impl PyFreeSpace {
         })
     }
 
-    /// Cell size [m].
+    /// Cell size \[m\].
     #[getter]
     fn resolution(&self) -> PyResult<f64> {
         Ok(self.lock()?.resolution())

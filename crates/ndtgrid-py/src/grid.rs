@@ -78,7 +78,7 @@ impl PyNdtGrid {
         self.read(py, NdtGrid::levels)
     }
 
-    /// Cell size [m].
+    /// Cell size \[m\].
     #[getter]
     fn cell_size(&self, py: Python<'_>) -> PyResult<f64> {
         self.read(py, NdtGrid::cell_size)

@@ -121,7 +121,7 @@ impl PyMapper {
         self.options.clone_ref(py)
     }
 
-    /// Cell size [m].
+    /// Cell size \[m\].
     #[getter]
     fn cell_size(&self, py: Python<'_>) -> PyResult<f64> {
         self.with_both(py, |g, _| g.cell_size())

@@ -36,13 +36,13 @@ impl PySmallObject {
 
 #[pymethods]
 impl PySmallObject {
-    /// `(2,)` centre of mass [m].
+    /// `(2,)` centre of mass \[m\].
     #[getter]
     fn center<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_slice(py, &self.center)
     }
 
-    /// `(K, 2)` centres of its cells [m].
+    /// `(K, 2)` centres of its cells \[m\].
     #[getter]
     fn cells<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         PyArray1::from_slice(py, &self.cells).reshape([self.cells.len() / 2, 2])

@@ -19,8 +19,8 @@ pub enum Area {
 }
 
 impl Area {
-    /// The area of a point at `range` [m] from the sensor, with Area 1 up to
-    /// and including `reliable_range` [m] (the paper: 0.5 m).
+    /// The area of a point at `range` \[m\] from the sensor, with Area 1 up to
+    /// and including `reliable_range` \[m\] (the paper: 0.5 m).
     pub fn of(range: f64, reliable_range: f64) -> Area {
         if range <= reliable_range {
             Area::Reliable

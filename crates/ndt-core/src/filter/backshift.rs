@@ -12,7 +12,7 @@ use crate::grid::NdtGrid;
 use crate::key::CellKey;
 
 /// §V step b-2: `true` when `grid` holds a cell that the beam from `sensor`
-/// to `hit` (map frame [m]) crosses within `window` [m] short of the hit,
+/// to `hit` (map frame \[m\]) crosses within `window` \[m\] short of the hit,
 /// other than the hit's own cell: "there are former grid data in the short
 /// of radiation direction".
 pub fn former_cell_short_of(

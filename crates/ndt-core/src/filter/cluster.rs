@@ -18,7 +18,7 @@ use crate::key::CellKey;
 
 /// §V step a-1: splits the valid beams (in beam order) into clusters of
 /// consecutive points. Beams `i` and `i + 1` belong to one cluster when their
-/// points are at most `gap + spacing_factor · r · δ` apart [m], with `r` the
+/// points are at most `gap + spacing_factor · r · δ` apart \[m\], with `r` the
 /// smaller of the two ranges and `δ` the angular step between adjacent beams
 /// (the angle between the two beams divided by how many beam indices apart
 /// they are): the second term keeps a far wall, whose points are farther
@@ -47,13 +47,13 @@ pub fn clusters(beams: &[Beam], gap: f64, spacing_factor: f64) -> Vec<Range<usiz
 /// §V step a-1, "select the cluster with small number": a cluster is a
 /// small (sub-grid scale) object when its lateral extent — the spread of its
 /// points across the direction from the sensor to their centre of mass —
-/// is at most `max_size` [m]. The radial spread is ignored on purpose: mixed
+/// is at most `max_size` \[m\]. The radial spread is ignored on purpose: mixed
 /// returns stretch a thin object along the beam, not across it.
 pub fn is_small(cluster: &[Beam], max_size: f64) -> bool {
     lateral_extent(cluster) <= max_size
 }
 
-/// Spread [m] of the points across the bearing of their centre of mass
+/// Spread \[m\] of the points across the bearing of their centre of mass
 /// (0 for a single point).
 pub fn lateral_extent(cluster: &[Beam]) -> f64 {
     let com = centre_of_mass(cluster);
@@ -71,7 +71,7 @@ pub fn lateral_extent(cluster: &[Beam]) -> f64 {
     hi - lo
 }
 
-/// §V step a-2: the centre of mass of a cluster's points, sensor frame [m]
+/// §V step a-2: the centre of mass of a cluster's points, sensor frame \[m\]
 /// (the origin for an empty cluster).
 pub fn centre_of_mass(cluster: &[Beam]) -> Vector2<f64> {
     if cluster.is_empty() {
@@ -82,7 +82,7 @@ pub fn centre_of_mass(cluster: &[Beam]) -> Vector2<f64> {
 
 /// §V step a-3: `true` for each point that lies behind the centre of mass
 /// `com` (sensor frame): farther than `com` along the bearing of `com` by
-/// more than `margin` [m] (plus 1 nm against round-off). Measuring along the
+/// more than `margin` \[m\] (plus 1 nm against round-off). Measuring along the
 /// bearing rather than by range keeps a cluster whose points lie at one
 /// range whole (their mean lies inside the arc, nearer than any of them) and
 /// never drops every point: the projections average exactly to `|com|`.

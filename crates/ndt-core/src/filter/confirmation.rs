@@ -30,7 +30,7 @@ use crate::key::CellKey;
 /// How many points on each side of a hit estimate the surface direction.
 const TANGENT_SPAN: usize = 3;
 
-/// The along-beam margin [m] before the hit `cluster[i]` within which step d
+/// The along-beam margin \[m\] before the hit `cluster[i]` within which step d
 /// removes nothing: `clear_margin / tan α` for a grazing angle `α < 45°`
 /// between the beam and the surface, else `clear_margin`. The surface
 /// direction is the chord between the points up to 3 beams either side in
@@ -62,10 +62,10 @@ pub fn grazing_margin(cluster: &[Beam], i: usize, sensor: Vector2<f64>, clear_ma
 /// What step d needs besides the beam.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Clearing {
-    /// A cell is passed only if the beam passes within this distance [m] of
+    /// A cell is passed only if the beam passes within this distance \[m\] of
     /// the mean of its points.
     pub pass_radius: f64,
-    /// Area 1 limit [m]: small-object cells farther away are kept.
+    /// Area 1 limit \[m\]: small-object cells farther away are kept.
     pub reliable_range: f64,
 }
 
@@ -81,9 +81,9 @@ pub struct Pass {
     pub left: bool,
 }
 
-/// §V step d for one beam from `sensor` to `hit` (map frame [m]): appends to
+/// §V step d for one beam from `sensor` to `hit` (map frame \[m\]): appends to
 /// `out` the map cells the beam passed through short of its hit — every cell
-/// the walk crosses up to `margin` [m] before the hit whose point mean lies
+/// the walk crosses up to `margin` \[m\] before the hit whose point mean lies
 /// within `pass_radius` of the beam and more than `margin` short of the hit —
 /// except cells of small objects (per `table`) beyond the reliable range.
 pub fn passed_cells(

@@ -28,18 +28,18 @@ pub mod raywalk;
 pub struct Beam {
     /// Index of the beam in the scan's `ranges`/`angles` arrays.
     pub index: usize,
-    /// Measured range [m].
+    /// Measured range \[m\].
     pub range: f64,
-    /// Beam angle in the sensor frame [rad].
+    /// Beam angle in the sensor frame \[rad\].
     pub angle: f64,
-    /// The hit in the sensor frame, `(r cos a, r sin a)` [m].
+    /// The hit in the sensor frame, `(r cos a, r sin a)` \[m\].
     pub local: Vector2<f64>,
-    /// The hit in the map frame [m].
+    /// The hit in the map frame \[m\].
     pub world: Vector2<f64>,
 }
 
 impl Beam {
-    /// A beam of range `range` [m] and angle `angle` [rad] seen from the
+    /// A beam of range `range` \[m\] and angle `angle` \[rad\] seen from the
     /// sensor pose `pose` (`T_map_scan`).
     pub fn new(index: usize, range: f64, angle: f64, pose: crate::Pose2) -> Self {
         let (s, c) = angle.sin_cos();

@@ -11,7 +11,7 @@ use crate::key::CellKey;
 /// One detected small (sub-grid scale) object.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SmallObject {
-    /// Centre of mass of the object's points, map frame [m]: `Σm / ΣM` over
+    /// Centre of mass of the object's points, map frame \[m\]: `Σm / ΣM` over
     /// its cells (eq. 6 sums).
     pub center: Vector2<f64>,
     /// Its cells, sorted by key.

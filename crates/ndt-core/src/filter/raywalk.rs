@@ -6,9 +6,9 @@ use nalgebra::Vector2;
 
 use crate::key::{CellKey, KeyBounds};
 
-/// Visits, in order from `from` to `to` (map frame [m]), every cell of size
-/// `cell_size` [m] that the segment crosses, calling `visit(key, t_in, t_out)`
-/// with the distances [m] from `from` at which the segment enters and leaves
+/// Visits, in order from `from` to `to` (map frame \[m\]), every cell of size
+/// `cell_size` \[m\] that the segment crosses, calling `visit(key, t_in, t_out)`
+/// with the distances \[m\] from `from` at which the segment enters and leaves
 /// the cell. Stops early when `visit` returns `false`.
 ///
 /// Nothing is visited when an end point is not finite or its cell index
@@ -84,7 +84,7 @@ pub fn walk_cells_in(
 }
 
 /// [`walk_cells`], stopping before the first cell entered farther than
-/// `stop` [m] from `from`.
+/// `stop` \[m\] from `from`.
 fn walk_until(
     from: Vector2<f64>,
     to: Vector2<f64>,

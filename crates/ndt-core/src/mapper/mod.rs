@@ -144,7 +144,7 @@ pub struct Mapper {
 }
 
 impl Mapper {
-    /// An empty map of `cell_size` [m] cells (the paper: 0.02) with `options`.
+    /// An empty map of `cell_size` \[m\] cells (the paper: 0.02) with `options`.
     pub fn new(cell_size: f64, options: MapperOptions) -> Result<Self> {
         Ok(Self {
             grid: NdtGrid::new(cell_size)?,

@@ -28,25 +28,25 @@ pub struct MapperOptions {
     /// Step d (§V-B(4)): remove map cells a new beam passed through short of
     /// its hit (small objects only in Area 1, big ones everywhere).
     pub radial_confirmation: bool,
-    /// Ranges below it are invalid [m] (default 0: only 0 is invalid).
+    /// Ranges below it are invalid \[m\] (default 0: only 0 is invalid).
     pub min_range: f64,
-    /// Ranges at or above it are invalid, "no return" [m] (default ∞).
+    /// Ranges at or above it are invalid, "no return" \[m\] (default ∞).
     pub max_range: f64,
-    /// Area 1 / Area 2 boundary [m]; the paper: 0.5 m for 2 cm objects
+    /// Area 1 / Area 2 boundary \[m\]; the paper: 0.5 m for 2 cm objects
     /// seen by a URG-04LX.
     pub reliable_range: f64,
-    /// a-1: base distance [m] between consecutive points of one cluster.
+    /// a-1: base distance \[m\] between consecutive points of one cluster.
     pub cluster_gap: f64,
     /// a-1: plus this many times the spacing of adjacent beams at the range
     /// of the points (so far walls stay whole).
     pub cluster_spacing_factor: f64,
-    /// a-1: a cluster whose lateral extent is at most this [m] is a small
+    /// a-1: a cluster whose lateral extent is at most this \[m\] is a small
     /// object (the paper's sticks are 1.3–1.5 cm).
     pub small_object_size: f64,
-    /// a-3: points more than this [m] behind the centre of mass are dropped
+    /// a-3: points more than this \[m\] behind the centre of mass are dropped
     /// (the paper: 0, "the data in back of the CoM").
     pub behind_com_margin: f64,
-    /// b-2: how far short of a new point [m] a former cell rejects it (the
+    /// b-2: how far short of a new point \[m\] a former cell rejects it (the
     /// paper measured a 5 cm shift; twice that by default).
     pub backshift_window: f64,
     /// b-1/c: the periodic check runs every this many scans (the paper: 3).
@@ -57,7 +57,7 @@ pub struct MapperOptions {
     /// c: keep a rarely seen cell that has an established 8-neighbour (ours;
     /// a sparsely hit far wall is not speckle).
     pub observation_support: bool,
-    /// d: the walk stops this far [m] short of the hit, or
+    /// d: the walk stops this far \[m\] short of the hit, or
     /// `clear_margin_relative` times the range if that is more (and more at
     /// grazing incidence: divided by `tan α` below 45°).
     pub clear_margin: f64,
@@ -65,7 +65,7 @@ pub struct MapperOptions {
     /// to ±1 % beyond 1 m: 1.5 % is three standard deviations).
     pub clear_margin_relative: f64,
     /// d: a cell counts as passed only if the beam passes within this
-    /// distance [m] of the mean of its points.
+    /// distance \[m\] of the mean of its points.
     pub pass_radius: f64,
 }
 

@@ -32,7 +32,7 @@ impl MapFilter {
     /// Adds one laser scan seen from `pose` (`T_map_scan`, the sensor's pose)
     /// to `grid`, through the §V elimination.
     ///
-    /// `ranges` [m] and `angles` [rad, sensor frame] hold one value per beam,
+    /// `ranges` \[m\] and `angles` \[rad, sensor frame\] hold one value per beam,
     /// in beam order (the order clustering follows). Beams whose range is 0,
     /// NaN, infinite, below `min_range` or at or above `max_range` are
     /// skipped. With `outlier_filter` off every other beam is stored. A scan

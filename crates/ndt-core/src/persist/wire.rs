@@ -18,7 +18,7 @@ use crate::mapper::{MapFilter, MapperOptions, RemovalCounts};
 /// A grid: cell size, pyramid levels and the fine cells, sorted by key.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GridV1 {
-    /// Cell size [m].
+    /// Cell size \[m\].
     pub cell_size: f64,
     /// Pyramid levels, fine level included.
     pub levels: u32,
@@ -35,9 +35,9 @@ pub struct CellV1 {
     pub iy: i32,
     /// `M`: number of points.
     pub count: u64,
-    /// `m` about the cell's centre [m].
+    /// `m` about the cell's centre \[m\].
     pub sum: [f64; 2],
-    /// `S` about the cell's centre, row-major [m²].
+    /// `S` about the cell's centre, row-major \[m²\].
     pub scatter: [f64; 4],
 }
 

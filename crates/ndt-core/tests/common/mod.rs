@@ -6,7 +6,7 @@ use ndt_core::Pose2;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
-/// A wall from `a` to `b` [m].
+/// A wall from `a` to `b` \[m\].
 pub type Segment = ([f64; 2], [f64; 2]);
 
 /// A 6 m × 4 m room with an inner box, a pillar-like square and a diagonal wall:
