@@ -167,7 +167,7 @@ def methods() -> list[peer_lib.Peer]:
             0.02,
             **{**PAPER, "levels": None, "rotation_search": 0.15},
         ),
-        ours("  + frozen unconstrained directions, r=1, σ floor 1 cm", 0.02, shape_cell=0.0),
+        ours("  + frozen unconstrained directions, r=1, σ floor 2 cm", 0.02, shape_cell=0.0),
         ours("  + fine cells shaped by their 32 cm ancestor = default match()", 0.02),
         ours("default + 3×3 pairing", 0.02, pair_neighbors=True),
         ours("16 cm grid, default match() (not 2 cm)", 0.16),

@@ -1,9 +1,10 @@
 """The sigma-floor sweep behind ``MatchOptions::sigma_floor`` (BENCHMARK.md, convergence study).
 
 Success of the default 2 cm ``match`` with each floor on the sets of
-``benches/convergence.py``: its real SICK pairs, the held-out pairs half-way between
-them, the URG-04LX pairs (peer-consensus reference) and the simulated pairs, with
-the same starts as that benchmark (``--seed``).
+``benches/convergence.py``: its 960 real SICK pairs (offsets 0, 0.125, ..., 0.875), 960
+further pairs between those (offsets 0.0625, 0.1875, ..., 0.9375: the held-out set of
+session 3's choice), the URG-04LX pairs (peer-consensus reference) and the simulated
+pairs, each with its own starts drawn as that benchmark draws them (``--seed``).
 
 Run: ``python benches/sigma_floor.py [--pairs 30] [--starts 8]``; prints a Markdown table.
 """
@@ -23,7 +24,9 @@ import convergence as cv
 import ndtgrid
 from ndtgrid.evaluation import pose_error
 
-FLOORS = (0.005, 0.01, 0.015, 0.02, 0.03)
+FLOORS = (0.005, 0.01, 0.015, 0.02, 0.025, 0.03)
+BENCH_OFFSETS = tuple(k / 8 for k in range(8))
+HELD_OUT_OFFSETS = tuple(k / 8 + 1 / 16 for k in range(8))
 
 
 def success(pairs: list[cv.Pair], starts: list[np.ndarray], floor: float) -> float:
@@ -48,8 +51,8 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
     sets = {
-        "SICK pairs": list(cv.real_pairs(args.pairs)),
-        "held-out SICK pairs": list(cv.real_pairs(args.pairs, offset=0.5)),
+        "SICK pairs": [p for o in BENCH_OFFSETS for p in cv.real_pairs(args.pairs, o)],
+        "held-out SICK pairs": [p for o in HELD_OUT_OFFSETS for p in cv.real_pairs(args.pairs, o)],
         "URG-04LX pairs": list(cv.urg_pairs(40)),
         "simulated pairs": list(cv.sim_pairs(8, args.seed)),
     }

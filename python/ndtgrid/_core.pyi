@@ -141,7 +141,7 @@ class NdtGrid:
         guess: ArrayLike,
         *,
         expansion: float = 10.0,
-        sigma_floor: float = 0.01,
+        sigma_floor: float = 0.02,
         shape_cell: float = 0.32,
         neighbor_search: bool = True,
         fuse_minority: bool = True,
@@ -180,13 +180,14 @@ class NdtGrid:
             Initial pose ``[x, y, theta]`` (m, m, rad).
         expansion : float, default 10.0
             ``k`` of eq. (8): both covariance eigenvalues are multiplied by it.
-        sigma_floor : float, default 0.01
+        sigma_floor : float, default 0.02
             Smallest standard deviation [m] a cell's distribution is given before
             the expansion: the scatter between two scans of one surface (range
-            noise, beam footprint, sampling; a URG-04LX is good to +-10 mm). 1 cm
-            was the best of 0.5-3 cm over the real pairs of
-            ``benches/convergence.py`` (benchmark and held-out SICK pairs, URG-04LX
-            pairs; BENCHMARK.md); lower it for a more precise sensor.
+            noise, beam footprint, sampling; a URG-04LX is good to +-10 mm, a
+            SICK LMS to +-15 mm). 2 cm was chosen among 0.5-3 cm on the real
+            pairs of ``benches/convergence.py`` and confirmed on 960 held-out
+            SICK pairs (``benches/sigma_floor.py``, BENCHMARK.md); lower it for
+            a more precise sensor.
         shape_cell : float, default 0.32
             Cells finer than this [m] keep their own mean but take the covariance
             of the pyramid cell of at least this size that holds them (the wall
@@ -268,7 +269,7 @@ class NdtGrid:
         pose: ArrayLike,
         *,
         expansion: float = 10.0,
-        sigma_floor: float = 0.01,
+        sigma_floor: float = 0.02,
         shape_cell: float = 0.32,
         neighbor_search: bool = True,
         fuse_minority: bool = True,

@@ -56,7 +56,7 @@ pub const CANDIDATE_VOXEL: f64 = 0.5;
 /// Options of [`NdtGrid::match_scan`]. The defaults are the paper's method
 /// (§IV-A: `k = 10`, neighbour search and fusion on) run coarse to fine over
 /// the pyramid (2–64 cm on a 2 cm grid) with a ±0.15 rad rotational
-/// multi-start on the coarsest level, unconstrained directions frozen, a 1 cm
+/// multi-start on the coarsest level, unconstrained directions frozen, a 2 cm
 /// σ floor and fine cells shaped by their 32 cm ancestor — the best of the
 /// settings measured by `benches/convergence.py` (see
 /// BENCHMARK.md). Neighbour search looks 1 cell around an empty cell (larger
@@ -73,7 +73,7 @@ pub struct MatchOptions {
     /// Smallest standard deviation \[m\] a cell's distribution is given before
     /// the expansion (> 0): the scatter between two scans of one surface
     /// (range noise, beam footprint, sampling). Default
-    /// [`DEFAULT_SIGMA_FLOOR`] (1 cm), chosen by measurement (see there);
+    /// [`DEFAULT_SIGMA_FLOOR`] (2 cm), chosen by measurement (see there);
     /// lower it for a more precise sensor.
     pub sigma_floor: f64,
     /// Cells finer than this \[m\] take the covariance shape of their ancestor

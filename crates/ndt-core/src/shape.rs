@@ -1,7 +1,7 @@
 //! Cell shapes from the pyramid: a fine cell's distribution takes its own
 //! mean and the covariance of the coarser cell that holds it.
 //!
-//! With 2 cm cells and a 1 cm σ floor every cell's own covariance (eq. 7) is
+//! With 2 cm cells and a 1-2 cm σ floor every cell's own covariance (eq. 7) is
 //! below the floor, so its distribution is an isotropic blob around where one
 //! scan happened to sample a surface. Matched against such blobs, a scan is
 //! pulled towards the other scan's sample positions along a wall as much as

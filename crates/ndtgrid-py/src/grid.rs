@@ -114,7 +114,7 @@ impl PyNdtGrid {
 
     /// Matches scan-frame points against the map from `guess`.
     #[pyo3(name = "match", signature = (
-        points, guess, *, expansion = 10.0, sigma_floor = 0.01, shape_cell = 0.32, neighbor_search = true, fuse_minority = true,
+        points, guess, *, expansion = 10.0, sigma_floor = 0.02, shape_cell = 0.32, neighbor_search = true, fuse_minority = true,
         pair_neighbors = false, search_radius = 1, max_iterations = 50, translation_tolerance = 1e-4,
         rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, rotation_search = 0.15, freeze_unconstrained = true, freeze_ratio = 0.1,
         levels = None,
@@ -180,7 +180,7 @@ impl PyNdtGrid {
 
     /// Score terms of eq. (1) at `pose` without solving.
     #[pyo3(signature = (
-        points, pose, *, expansion = 10.0, sigma_floor = 0.01, shape_cell = 0.32, neighbor_search = true, fuse_minority = true,
+        points, pose, *, expansion = 10.0, sigma_floor = 0.02, shape_cell = 0.32, neighbor_search = true, fuse_minority = true,
         pair_neighbors = false, search_radius = 1
     ))]
     #[allow(clippy::too_many_arguments)]
