@@ -187,3 +187,52 @@ fn whole_scan_terms_equal_central_differences() {
     }
     assert_eq!(checked, 50);
 }
+
+#[test]
+fn a_weighted_point_counts_as_that_many_copies_and_weight_one_is_bit_identical() {
+    use ndt_core::score::Accumulator;
+    let mut rng = StdRng::seed_from_u64(11);
+    for _ in 0..200 {
+        let g = random_gaussian(&mut rng);
+        let x = Vector2::new(rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0));
+        let p = Pose2::new(
+            g.mean.x - x.x + rng.random_range(-0.05..0.05),
+            g.mean.y - x.y + rng.random_range(-0.05..0.05),
+            rng.random_range(-0.02..0.02),
+        );
+        let (xw, sc) = (p.transform(x), p.theta.sin_cos());
+        let mut once = Accumulator::default();
+        once.add(x, xw, sc, &g, 3.0, Order::Derivatives);
+        let mut thrice = Accumulator::default();
+        for _ in 0..3 {
+            thrice.add(x, xw, sc, &g, 1.0, Order::Derivatives);
+        }
+        let (a, b) = (once.finish(), thrice.finish());
+        assert!((a.score - b.score).abs() <= 1e-12 * b.score.abs().max(1e-300));
+        assert!((a.gradient - b.gradient).norm() <= 1e-12 * b.gradient.norm().max(1e-300));
+        assert!((a.hessian - b.hessian).norm() <= 1e-12 * b.hessian.norm().max(1e-300));
+        // Weight 1 through the accumulator is the public per-point path, bit for bit.
+        let mut one = Accumulator::default();
+        one.add(x, xw, sc, &g, 1.0, Order::Derivatives);
+        let mut t = ScoreTerms::default();
+        t.add(x, xw, sc, &g, Order::Derivatives);
+        assert_eq!(one.finish(), t);
+    }
+}
+
+#[test]
+fn score_alone_equals_the_score_of_score_terms() {
+    let walls = common::room();
+    let mut grid = NdtGrid::new(0.02).unwrap();
+    let at = Pose2::new(0.1, -0.2, 0.3);
+    grid.insert(&common::urg_scan(&walls, at, 0.0, 1), at)
+        .unwrap();
+    let scan = common::urg_scan(&walls, at, 0.0, 2);
+    let options = MatchOptions::default();
+    for d in [0.0, 0.01, 0.05] {
+        let p = Pose2::new(at.x + d, at.y - d, at.theta + d);
+        let full = grid.score_terms(&scan, p, &options).unwrap().score;
+        assert_eq!(grid.score(&scan, p, &options).unwrap(), full);
+        assert!(full > 0.0);
+    }
+}
