@@ -277,6 +277,56 @@ impl NdtGrid {
     }
 }
 
+/// Levels above the fine one that [`OccupancyProbe`] looks at (8 × 8 fine
+/// cells per ancestor).
+const PROBE_DEPTH: usize = 3;
+
+/// Answers "may fine cell `key` hold points?" from a coarser pyramid level:
+/// no fine cell exists under an absent ancestor (every level is summed from
+/// the fine cells, and a fine cell holds at least one point). Remembers the
+/// last ancestor asked about, so a walk along a beam through empty space
+/// looks one ancestor up per 8 or so fine cells instead of every fine cell.
+#[derive(Debug)]
+pub struct OccupancyProbe<'a> {
+    ancestors: Option<&'a FxHashMap<CellKey, CellStats>>,
+    depth: usize,
+    last: Option<(CellKey, bool)>,
+}
+
+impl OccupancyProbe<'_> {
+    /// `false` only when no fine cell `key` exists; `true` when it may.
+    #[inline]
+    pub fn may_hold(&mut self, key: CellKey) -> bool {
+        let Some(cells) = self.ancestors else {
+            return true;
+        };
+        let at = crate::pyramid::coarse_key(key, self.depth);
+        match self.last {
+            Some((k, found)) if k == at => found,
+            _ => {
+                let found = cells.contains_key(&at);
+                self.last = Some((at, found));
+                found
+            }
+        }
+    }
+}
+
+impl NdtGrid {
+    /// An [`OccupancyProbe`] of this grid (with a single-level grid it
+    /// answers `true` for every cell).
+    pub fn occupancy_probe(&self) -> OccupancyProbe<'_> {
+        let depth = PROBE_DEPTH.min(self.levels() - 1);
+        OccupancyProbe {
+            ancestors: (depth > 0)
+                .then(|| self.pyramid.level(depth).map(Level::cells))
+                .flatten(),
+            depth,
+            last: None,
+        }
+    }
+}
+
 /// Levels from `level` up to the first level whose cells are at least
 /// `shape_cell` \[m\] (see [`crate::shape`]); 0 when `shape_cell` is 0 or no
 /// coarser level is that large.

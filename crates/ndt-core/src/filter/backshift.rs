@@ -36,8 +36,9 @@ pub fn former_cell_short_of(
         hit - ray * (window / range)
     };
     let mut found = false;
+    let mut probe = grid.occupancy_probe();
     walk_cells_in(start, hit, cell_size, grid.key_bounds(), |key, _, _| {
-        if key != hit_key && grid.stats(key).is_some() {
+        if key != hit_key && probe.may_hold(key) && grid.stats(key).is_some() {
             found = true;
         }
         !found

@@ -103,12 +103,16 @@ pub fn passed_cells(
     let dir = ray / range;
     let reach = range - margin;
     let cell_size = grid.cell_size();
+    let mut probe = grid.occupancy_probe();
     walk_cells_in(
         sensor,
         sensor + dir * reach,
         cell_size,
         grid.key_bounds(),
         |key, _, _| {
+            if !probe.may_hold(key) {
+                return true;
+            }
             let Some(stats) = grid.stats(key) else {
                 return true;
             };
