@@ -20,7 +20,7 @@ huge coordinates (insert)       ValueError   points: point i at (x, y) m is outs
 huge coordinates (match)        ValueError   same
 pose of 2 or 4 values, (3, 3)   ValueError   pose: expected 3 values [x, y, theta], got shape ..
 pose / guess with NaN or inf    ValueError   pose: expected finite values, got nan at index i
-cell_size <= 0, NaN, inf        ValueError   cell_size: expected a finite cell size > 0 m, ...
+cell_size < 1 mm, NaN, inf      ValueError   cell_size: expected a finite cell size >= 0.001 m, ...
 expansion <= 0 or NaN           ValueError   expansion: expected a finite value > 0, got ...
 search_radius < 0               ValueError   search_radius: expected a non-negative integer ...
 search_radius > 1000            ValueError   search_radius: expected a radius of at most ...
@@ -274,9 +274,11 @@ def test_bad_input_raises_and_leaves_map_unchanged(
     assert grid.match(GOOD, POSE).num_matched > 0
 
 
-@pytest.mark.parametrize("bad", [0.0, -0.02, float("nan"), float("inf")])
+@pytest.mark.parametrize("bad", [0.0, -0.02, float("nan"), float("inf"), 1e-8, 0.000999])
 def test_bad_cell_size(bad: float) -> None:
-    with pytest.raises(ValueError, match=r"^cell_size: expected a finite cell size > 0 m, got"):
+    with pytest.raises(
+        ValueError, match=r"^cell_size: expected a finite cell size >= 0\.001 m, got"
+    ):
         ndtgrid.NdtGrid(bad)
 
 
@@ -611,7 +613,7 @@ def test_bad_mapper_option_types() -> None:
     assert str(info.value) == "must be real number, not str"
     with pytest.raises(ValueError) as info:
         ndtgrid.Mapper(0.0)
-    assert str(info.value) == "cell_size: expected a finite cell size > 0 m, got 0"
+    assert str(info.value) == "cell_size: expected a finite cell size >= 0.001 m, got 0"
 
 
 ODOMETRY_CONFIG_CASES = [
@@ -662,7 +664,7 @@ def test_bad_odometry_config(config: dict[str, Any], message: str) -> None:
 def test_bad_odometry_construction() -> None:
     with pytest.raises(ValueError) as info:
         ndtgrid.Odometry(cell_size=-1.0)
-    assert str(info.value) == "cell_size: expected a finite cell size > 0 m, got -1"
+    assert str(info.value) == "cell_size: expected a finite cell size >= 0.001 m, got -1"
     with pytest.raises(TypeError) as info:
         ndtgrid.Odometry(config={})  # type: ignore[arg-type]
     assert str(info.value) == "config: expected an OdometryConfig, got dict"

@@ -60,7 +60,7 @@ def test_api_names_defaults_and_repr() -> None:
         ({"check_interval": 0}, ValueError, "check_interval: expected an integer >= 1"),
         ({"min_observations": -1}, ValueError, "min_observations: expected a non-negative"),
         ({"pass_radius": float("nan")}, ValueError, "pass_radius: expected a finite length"),
-        ({"cell_size": 0.0}, ValueError, "cell_size: expected a finite cell size > 0 m"),
+        ({"cell_size": 0.0}, ValueError, "cell_size: expected a finite cell size >= 0.001 m"),
         ({"no_such_option": 1}, TypeError, "no_such_option"),
     ],
 )

@@ -81,7 +81,7 @@ class NdtGrid:
     Parameters
     ----------
     cell_size : float, default 0.02
-        Side of the square cells [m] (the paper: 2 cm).
+        Side of the square cells [m] (the paper: 2 cm), at least 1 mm.
     levels : int, default 6
         Levels of the multi-resolution pyramid kept with the map (1 = the fine
         grid only, at most 12). Level ``l`` has cells ``cell_size * 2**l``; its
@@ -657,7 +657,7 @@ class Mapper:
     Parameters
     ----------
     cell_size : float, default 0.02
-        Side of the square cells [m] (the paper: 2 cm).
+        Side of the square cells [m] (the paper: 2 cm), at least 1 mm.
     outlier_filter : bool, default True
         ``False`` stores every valid point and removes nothing (for comparison).
     **options

@@ -128,11 +128,12 @@ fn overflow_error_names_the_point() {
 
 #[test]
 fn invalid_cell_size_is_rejected() {
-    for bad in [0.0, -0.1, f64::NAN, f64::INFINITY] {
+    for bad in [0.0, -0.1, f64::NAN, f64::INFINITY, 1e-8, 0.000_999] {
         let msg = NdtGrid::new(bad).unwrap_err().to_string();
         assert!(
-            msg.starts_with("cell_size: expected a finite cell size > 0 m, got"),
+            msg.starts_with("cell_size: expected a finite cell size >= 0.001 m, got"),
             "{msg}"
         );
     }
+    assert!(NdtGrid::new(0.001).is_ok());
 }

@@ -31,7 +31,10 @@ fn the_probe_admits_every_occupied_cell_and_rules_out_empty_blocks() {
         }
     }
     // Outside the ±1 m square every 8 × 8 block is empty.
-    assert!(ruled_out * 3 > empty, "{ruled_out} of {empty} empty cells ruled out");
+    assert!(
+        ruled_out * 3 > empty,
+        "{ruled_out} of {empty} empty cells ruled out"
+    );
     // A one-level grid has no coarser level to ask: it admits everything.
     let single = NdtGrid::with_levels(0.02, 1).unwrap();
     assert!(single.occupancy_probe().may_hold(CellKey { ix: 5, iy: 5 }));
