@@ -184,3 +184,19 @@ def test_se2_helpers_round_trip() -> None:
     np.testing.assert_allclose(se2.between(a, c), b, atol=1e-12)
     np.testing.assert_allclose(se2.compose(a, se2.inverse(a)), 0, atol=1e-12)
     assert -np.pi < c[2] <= np.pi
+
+
+def test_memory_bytes_counts_the_sums_and_the_prepared_distributions() -> None:
+    empty = ndtgrid.NdtGrid(0.02).memory_bytes
+    grid = room_map()
+    sums = grid.memory_bytes
+    # Every level's sums: at least one 56-byte record per occupied fine cell.
+    assert sums > empty + 56 * len(grid)
+    grid.match(scan((0.1, 0.0, 0.2), seed=9), np.array([0.1, 0.0, 0.2]))
+    built = grid.memory_bytes
+    # The distributions of six levels, at least a 64-byte one per fine cell.
+    assert built > sums + 64 * len(grid)
+    assert built / len(grid) < 2000
+    # A second match with the same options adds nothing.
+    grid.match(scan((0.1, 0.0, 0.2), seed=9), np.array([0.1, 0.0, 0.2]))
+    assert grid.memory_bytes == built

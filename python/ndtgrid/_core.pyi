@@ -115,6 +115,14 @@ class NdtGrid:
         """Pyramid levels kept (fine level included)."""
     def __len__(self) -> int:
         """Number of cells holding at least one point."""
+    @property
+    def memory_bytes(self) -> int:
+        """Heap bytes the grid holds: the sums of every pyramid level and the
+        distributions prepared for matching (built by the first ``match`` with
+        a given set of options, kept up to date by ``insert``), look-up
+        tables included. An estimate from the tables' capacities (hashbrown's
+        layout; the allocator's own overhead is not counted):
+        ``memory_bytes / len(grid)`` is the cost of an occupied cell."""
     def insert(self, points: ArrayLike, pose: ArrayLike) -> None:
         """Add a scan to the map (eq. 6).
 

@@ -240,6 +240,20 @@ impl NdtGrid {
         self.pyramid.bounds()
     }
 
+    /// Heap bytes the grid holds (an estimate, see
+    /// [`crate::table::hash_map_bytes`]): every pyramid level's sums and the
+    /// prepared distributions with their look-up tables. Divided by
+    /// [`NdtGrid::len`], the memory per occupied fine cell.
+    pub fn heap_bytes(&self) -> usize {
+        let entry = std::mem::size_of::<(CellKey, CellStats)>();
+        let sums: usize = (0..self.levels())
+            .filter_map(|l| self.pyramid.level(l))
+            .map(|lv| crate::table::hash_map_bytes(lv.cells().capacity(), entry))
+            .sum();
+        let prepared: usize = self.lock_prepared().iter().map(|d| d.heap_bytes()).sum();
+        sums + prepared
+    }
+
     /// Keys of every occupied cell, in no particular order.
     pub fn keys(&self) -> impl Iterator<Item = CellKey> + '_ {
         self.fine().keys().copied()

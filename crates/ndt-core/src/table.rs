@@ -31,6 +31,22 @@ fn split(key: CellKey) -> ((i32, i32), usize) {
     (tile, slot)
 }
 
+/// Heap bytes of a hash map with `capacity` entries of `entry` bytes, as
+/// hashbrown lays it out: a power-of-two number of buckets at most 7/8 full,
+/// each with its entry and one control byte, plus one group of control
+/// bytes. An estimate (the allocator's own overhead is not counted).
+pub fn hash_map_bytes(capacity: usize, entry: usize) -> usize {
+    if capacity == 0 {
+        return 0;
+    }
+    let buckets = if capacity < 8 {
+        (capacity + 1).next_power_of_two()
+    } else {
+        (capacity * 8 / 7).next_power_of_two()
+    };
+    buckets * (entry + 1) + 16
+}
+
 /// Values of type `T` keyed by [`CellKey`], in tiles (see the module docs).
 #[derive(Debug, Clone)]
 pub struct CellTable<T> {
@@ -156,8 +172,10 @@ impl<T> CellTable<T> {
             + self.slots.capacity() * std::mem::size_of::<Tile>()
             + self.used.capacity() * 4
             + self.free_tiles.capacity() * 4
-            // hashbrown: one control byte per bucket besides the entry.
-            + self.tiles.capacity() * (std::mem::size_of::<((i32, i32), u32)>() + 1)
+            + hash_map_bytes(
+                self.tiles.capacity(),
+                std::mem::size_of::<((i32, i32), u32)>(),
+            )
     }
 
     /// A reader that remembers the last tile it used (see [`Cursor`]).

@@ -88,6 +88,12 @@ impl PyNdtGrid {
         self.read(py, NdtGrid::len)
     }
 
+    /// Heap bytes held (estimate): every pyramid level and the prepared distributions.
+    #[getter]
+    fn memory_bytes(&self, py: Python<'_>) -> PyResult<usize> {
+        self.read(py, NdtGrid::heap_bytes)
+    }
+
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
         self.read(py, |g| {
             format!("NdtGrid(cell_size={}, cells={})", g.cell_size(), g.len())
