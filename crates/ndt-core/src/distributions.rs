@@ -9,7 +9,6 @@ use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::cell::{CellStats, Gaussian, MIN_POINTS};
 use crate::key::CellKey;
-use crate::pyramid::coarse_key;
 use crate::shape::Shape;
 use crate::table::{CellTable, Cursor};
 
@@ -177,8 +176,8 @@ fn distribution_of(
     // Own mean, the ancestor's covariance (crate::shape), when the ancestor
     // has a distribution of its own (Gaussian::with_shape, bit for bit).
     if let Some(s) = shape {
-        let at = coarse_key(key, s.depth);
-        if let Some(region) = s.cells.get(&at).filter(|a| a.count >= MIN_POINTS) {
+        let (at, region) = s.ancestor(key);
+        if let Some(region) = region.filter(|a| a.count >= MIN_POINTS) {
             let covariance = shapes.entry(at).or_insert_with(|| {
                 Gaussian::shape_of(region, options.sigma_floor, options.expansion)
             });

@@ -31,10 +31,12 @@ pub struct Shape<'a> {
 }
 
 impl<'a> Shape<'a> {
-    /// The ancestor of cell `key` of the distributions' level, if occupied.
+    /// The key of the ancestor of cell `key` of the distributions' level,
+    /// and its sums if it is occupied.
     #[inline]
-    pub fn ancestor(self, key: CellKey) -> Option<&'a CellStats> {
-        self.cells.get(&coarse_key(key, self.depth))
+    pub fn ancestor(self, key: CellKey) -> (CellKey, Option<&'a CellStats>) {
+        let at = coarse_key(key, self.depth);
+        (at, self.cells.get(&at))
     }
 
     /// Every occupied cell of `cells` (the distributions' level) under the
