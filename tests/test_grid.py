@@ -200,3 +200,17 @@ def test_memory_bytes_counts_the_sums_and_the_prepared_distributions() -> None:
     # A second match with the same options adds nothing.
     grid.match(scan((0.1, 0.0, 0.2), seed=9), np.array([0.1, 0.0, 0.2]))
     assert grid.memory_bytes == built
+
+
+def test_parallel_match_agrees_with_one_thread() -> None:
+    grid = room_map()
+    truth = np.array([0.1, -0.05, 0.3])
+    dense = np.vstack([scan(tuple(truth), seed=s) for s in range(36)])
+    assert len(dense) >= 16384
+    guess = truth + np.array([0.03, -0.02, 0.02])
+    serial = grid.match(dense, guess)
+    parallel = grid.match(dense, guess, parallel=True)
+    again = grid.match(dense, guess, parallel=True)
+    np.testing.assert_array_equal(parallel.pose, again.pose)
+    np.testing.assert_allclose(parallel.pose, serial.pose, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(parallel.pose, truth, atol=0.01)

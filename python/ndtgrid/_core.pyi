@@ -165,6 +165,7 @@ class NdtGrid:
         freeze_ratio: float = 0.1,
         levels: int | None = None,
         expansion_phases: Sequence[float] | None = None,
+        parallel: bool = False,
     ) -> MatchResult:
         """Match a scan against the map by Newton's method on eq. (1).
 
@@ -259,6 +260,14 @@ class NdtGrid:
             The phased adjustment of the authors' earlier paper (ICRA 2008):
             solve with each ``k`` in turn (e.g. ``[100, 10, 1]``), each from the
             previous result; overrides ``expansion``.
+        parallel : bool, default False
+            Score scans of at least 16384 points on all cores (rayon's pool;
+            ``RAYON_NUM_THREADS`` limits it), in fixed chunks of 2048 points
+            summed in order: the pose does not depend on the number of threads
+            and differs from the one-thread result in the last bits. Off by
+            default: on 2 cores 16384 / 32000 points gained 1.15 / 1.31x (8192
+            did not), and Python threads matching different scans use the cores
+            better (the GIL is released).
 
         Returns
         -------

@@ -4,7 +4,9 @@
 //!
 //! The map is the synthetic room of the tests, built from eight scans; the
 //! matched scan is taken 3 cm / 1° away from its guess. `match` uses the
-//! default options (pyramid), `match_paper` the paper's method alone.
+//! default options (pyramid), `match_paper` the paper's method alone,
+//! `match_large` matches 8192-, 16384- and 32000-point scans (2 cm) with and without
+//! `MatchOptions::parallel`.
 //! `insert` keeps the prepared distributions of a default match up to date
 //! (as in a SLAM loop), `insert_sums_only` has none prepared (eq. 6 and the
 //! pyramid's sums only), `pyramid_update` is the pyramid's part of that.
@@ -148,5 +150,36 @@ fn bench_match_with(c: &mut Criterion, name: &str, options: &MatchOptions) {
     group.finish();
 }
 
-criterion_group!(benches, bench_insert, bench_pyramid, bench_match);
+/// Large scans, one thread against `parallel` (rayon, all cores).
+fn bench_large(c: &mut Criterion) {
+    let mut group = c.benchmark_group("match_large");
+    group.sample_size(20);
+    let grid = map(2000, 0.02);
+    let truth = Pose2::new(0.1, -0.05, 0.3);
+    let guess = Pose2::new(truth.x + 0.03, truth.y - 0.02, truth.theta + 0.017);
+    for beams in [8192usize, 16384, 32000] {
+        let pts = scan(beams, truth, 42);
+        group.throughput(Throughput::Elements(pts.len() as u64));
+        for parallel in [false, true] {
+            let options = MatchOptions {
+                parallel,
+                ..MatchOptions::default()
+            };
+            let _ = grid.match_scan(&pts, guess, &options);
+            let name = if parallel { "parallel" } else { "one_thread" };
+            group.bench_with_input(BenchmarkId::new(name, beams), &pts, |b, pts| {
+                b.iter(|| grid.match_scan(black_box(pts), guess, &options))
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    bench_insert,
+    bench_pyramid,
+    bench_match,
+    bench_large
+);
 criterion_main!(benches);

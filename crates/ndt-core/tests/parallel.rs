@@ -1,0 +1,54 @@
+//! `MatchOptions::parallel`: the same pose on 1 or 2 threads, and the
+//! one-thread result to within rounding.
+
+mod common;
+
+use ndt_core::{MatchOptions, NdtGrid, Pose2};
+
+fn setup() -> (NdtGrid, Vec<[f64; 2]>, Pose2, Pose2) {
+    let walls = common::room();
+    let mut grid = NdtGrid::new(0.02).unwrap();
+    for (i, p) in [(0.0, 0.0, 0.0), (0.3, 0.2, 1.0), (-0.4, -0.3, 2.5)]
+        .iter()
+        .enumerate()
+    {
+        let pose = Pose2::new(p.0, p.1, p.2);
+        grid.insert(&common::scan(&walls, pose, 2000, 4.0, 0.01, i as u64), pose)
+            .unwrap();
+    }
+    let truth = Pose2::new(0.1, -0.05, 0.3);
+    let scan = common::scan(&walls, truth, 17000, 4.0, 0.01, 9);
+    let guess = Pose2::new(truth.x + 0.03, truth.y - 0.02, truth.theta + 0.02);
+    (grid, scan, guess, truth)
+}
+
+#[test]
+fn parallel_matches_do_not_depend_on_the_thread_count_and_agree_with_one_thread() {
+    let (grid, scan, guess, truth) = setup();
+    assert!(scan.len() >= ndt_core::matcher::PARALLEL_MIN_POINTS);
+    let parallel = MatchOptions {
+        parallel: true,
+        ..MatchOptions::default()
+    };
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| grid.match_scan(&scan, guess, &parallel).unwrap())
+    };
+    let (one, two) = (on(1), on(2));
+    assert_eq!(one, two);
+    let serial = grid
+        .match_scan(&scan, guess, &MatchOptions::default())
+        .unwrap();
+    for (a, b) in [
+        (one.pose.x, serial.pose.x),
+        (one.pose.y, serial.pose.y),
+        (one.pose.theta, serial.pose.theta),
+    ] {
+        assert!((a - b).abs() < 1e-9, "{a} vs {b}");
+    }
+    assert!((one.score - serial.score).abs() < 1e-9 * serial.score);
+    assert!((one.pose.x - truth.x).abs() < 0.01 && (one.pose.y - truth.y).abs() < 0.01);
+}
