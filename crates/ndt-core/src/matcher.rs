@@ -340,11 +340,9 @@ pub(crate) fn evaluate(
         })
         .collect();
     let mut total = ScoreTerms::default();
-    for t in parts {
-        total.score += t.score;
-        total.gradient += t.gradient;
-        total.hessian += t.hessian;
-        total.matched += t.matched;
+    for t in &parts {
+        total.add_terms(t);
+        total.matched += t.matched; // disjoint points
     }
     total
 }
@@ -413,10 +411,8 @@ fn stack_terms(
             options,
             order,
         );
-        total.score += t.score;
-        total.gradient += t.gradient;
-        total.hessian += t.hessian;
-        total.matched = total.matched.max(t.matched);
+        total.add_terms(&t);
+        total.matched = total.matched.max(t.matched); // the same points on each level
     }
     total
 }

@@ -40,6 +40,15 @@ impl Default for ScoreTerms {
 }
 
 impl ScoreTerms {
+    /// Adds `other`'s score, gradient and Hessian (terms of other points, or
+    /// of other pyramid levels); `matched` is the caller's to combine.
+    #[inline]
+    pub fn add_terms(&mut self, other: &ScoreTerms) {
+        self.score += other.score;
+        self.gradient += other.gradient;
+        self.hessian += other.hessian;
+    }
+
     /// Adds point `x` (scan frame) mapped to `xw = R(θ) x + t` (eq. 2) and
     /// paired with `dist` (the caller counts matched points: a point may be
     /// paired with several distributions); see [`Accumulator::add`].
