@@ -41,9 +41,10 @@ pub fn own_cell_pairs<'a>(
 ) -> impl Iterator<Item = (Vector2<f64>, &'a crate::cell::Gaussian)> + 'a {
     let inv = 1.0 / dists.cell_size();
     let mut cursor = dists.cursor();
+    let sin_cos = pose.theta.sin_cos();
     points.iter().filter_map(move |p| {
         let x = Vector2::new(p[0], p[1]);
-        let key = crate::key::CellKey::of(pose.transform(x), inv)?;
+        let key = crate::key::CellKey::of(pose.transform_with(sin_cos, x), inv)?;
         cursor.get(key).map(|g| (x, g))
     })
 }

@@ -19,6 +19,7 @@
 #![deny(missing_docs)]
 #![warn(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+pub mod batch;
 pub mod cell;
 pub mod degeneracy;
 pub mod distributions;
@@ -30,6 +31,7 @@ pub mod information;
 pub mod key;
 pub mod mapper;
 pub mod matcher;
+pub mod memo;
 pub mod neighbor;
 pub mod odometry;
 pub mod persist;

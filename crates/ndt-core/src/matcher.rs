@@ -4,6 +4,7 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector2};
 
+use crate::batch::{PairBlock, Scan};
 use crate::cell::{Gaussian, DEFAULT_SIGMA_FLOOR};
 use crate::degeneracy::{constrained_projector, unconstrained_directions};
 use crate::distributions::{DistOptions, Distributions};
@@ -11,6 +12,7 @@ use crate::error::{check_bound, check_finite, NdtError, Result};
 use crate::grid::{check_points, NdtGrid};
 use crate::information::{own_cell_pairs, point_to_plane_information};
 use crate::key::CellKey;
+use crate::memo::LevelMemo;
 use crate::neighbor::nearest_in_rings_with;
 use crate::reduce::voxel_runs;
 use crate::score::{Accumulator, Order, ScoreTerms};
@@ -358,12 +360,17 @@ fn evaluate_serial(
     order: Order,
 ) -> ScoreTerms {
     let sin_cos = pose.theta.sin_cos();
+    let scan = Scan {
+        points,
+        weights,
+        sin_cos,
+        order,
+    };
     let mut terms = Accumulator::default();
+    let mut block = PairBlock::default();
     let mut cursor = dists.cursor();
     for (i, p) in points.iter().enumerate() {
-        let x = Vector2::new(p[0], p[1]);
-        let xw = pose.transform(x);
-        let w = weights.and_then(|w| w.get(i)).copied().unwrap_or(1.0);
+        let xw = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
         if options.pair_neighbors {
             let Some(key) = CellKey::of(xw, inv_cell) else {
                 continue;
@@ -372,7 +379,7 @@ fn evaluate_serial(
             for dy in -1..=1 {
                 for dx in -1..=1 {
                     if let Some(g) = cursor.get(key.offset(dx, dy)) {
-                        terms.add(x, xw, sin_cos, g, w, order);
+                        block.push(i, xw, g, &scan, &mut terms);
                         any = true;
                     }
                 }
@@ -383,34 +390,45 @@ fn evaluate_serial(
             }
         }
         if let Some(g) = pair(&mut cursor, xw, inv_cell, options) {
-            terms.add(x, xw, sin_cos, g, w, order);
+            block.push(i, xw, g, &scan, &mut terms);
             terms.matched += 1;
         }
     }
+    block.flush(&scan, &mut terms);
     terms.finish()
 }
 
 /// Score terms of (weighted) points at `pose` summed over the pyramid levels
-/// of one coarse-to-fine stage (see [`LEVEL_WINDOW`]).
+/// of one coarse-to-fine stage (see [`LEVEL_WINDOW`]); with a `memo`, each
+/// level's terms are taken from it when computed there before, and recorded.
 fn stack_terms(
-    stack: &[Arc<Distributions>],
+    stack: &[(usize, Arc<Distributions>)],
     points: &[[f64; 2]],
     weights: Option<&[f64]>,
     pose: Pose2,
     options: &MatchOptions,
     order: Order,
+    mut memo: Option<&mut LevelMemo>,
 ) -> ScoreTerms {
     let mut total = ScoreTerms::default();
-    for d in stack {
-        let t = evaluate(
-            d,
-            points,
-            weights,
-            pose,
-            1.0 / d.cell_size(),
-            options,
-            order,
-        );
+    for (level, d) in stack {
+        let known = memo.as_ref().and_then(|m| m.get(*level, pose, order));
+        let t = known.unwrap_or_else(|| {
+            evaluate(
+                d,
+                points,
+                weights,
+                pose,
+                1.0 / d.cell_size(),
+                options,
+                order,
+            )
+        });
+        if known.is_none() {
+            if let Some(m) = memo.as_mut() {
+                m.put(*level, pose, order, t);
+            }
+        }
         total.add_terms(&t);
         total.matched = total.matched.max(t.matched); // the same points on each level
     }
@@ -476,28 +494,30 @@ impl NdtGrid {
         let mut pose = guess;
         let mut iterations = 0;
         let mut outcome = None;
-        let mut stack: Vec<Arc<Distributions>> = Vec::with_capacity(levels);
+        let mut stack: Vec<(usize, Arc<Distributions>)> = Vec::with_capacity(levels);
+        let mut memo = LevelMemo::default();
         for level in (0..levels).rev() {
             let Some(dists) = self.distributions(level, options.dist_options()) else {
                 break;
             };
             let cell = dists.cell_size();
             let mut solver = options.solver_options(cell, level);
-            stack.push(dists);
+            stack.push((level, dists));
             if stack.len() > LEVEL_WINDOW {
                 stack.remove(0);
             }
             // Not on the first stage: its start may be far off, and pairs
             // found there would misjudge the geometry.
             if options.freeze_unconstrained && level + 1 < levels {
-                if let Some(d) = stack.first() {
+                if let Some((_, d)) = stack.first() {
                     let info = point_to_plane_information(own_cell_pairs(d, points, pose), pose);
                     solver.projector = constrained_projector(&info, lever, options.freeze_ratio);
                 }
             }
-            let objective =
-                |p: Pose2, order: Order| stack_terms(&stack, points, None, p, options, order);
-            let mut solved = minimise(pose, &solver, objective);
+            let mut objective = |p: Pose2, order: Order| {
+                stack_terms(&stack, points, None, p, options, order, Some(&mut memo))
+            };
+            let mut solved = minimise(pose, &solver, &mut objective);
             // The first (coarsest) stage also starts from the guess rotated
             // by ± `rotation_search` and keeps the best score: Newton alone
             // rarely turns a scan by more than a few degrees. Above the fine
@@ -514,7 +534,15 @@ impl NdtGrid {
                 };
                 let few = voxel_runs(points, voxel);
                 let rough = |p: Pose2, order: Order| {
-                    stack_terms(&stack, &few.points, Some(&few.weights), p, options, order)
+                    stack_terms(
+                        &stack,
+                        &few.points,
+                        Some(&few.weights),
+                        p,
+                        options,
+                        order,
+                        None,
+                    )
                 };
                 for sign in [-1.0, 1.0] {
                     let start =
@@ -530,7 +558,7 @@ impl NdtGrid {
                     if objective(landed.pose, Order::Value).score <= solved.terms.score {
                         continue;
                     }
-                    let candidate = minimise(landed.pose, &solver, objective);
+                    let candidate = minimise(landed.pose, &solver, &mut objective);
                     iterations += candidate.iterations;
                     if candidate.terms.score > solved.terms.score {
                         solved = candidate;
@@ -549,7 +577,7 @@ impl NdtGrid {
             });
         };
         let hessian = outcome.terms.hessian;
-        let information = stack.first().map_or_else(Matrix3::zeros, |d| {
+        let information = stack.first().map_or_else(Matrix3::zeros, |(_, d)| {
             point_to_plane_information(own_cell_pairs(d, points, pose), pose)
         });
         Ok(MatchResult {

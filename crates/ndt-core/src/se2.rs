@@ -67,7 +67,13 @@ impl Pose2 {
     /// eq. (2): `x' = R(θ) x + t` \[m\].
     #[inline]
     pub fn transform(self, p: Vector2<f64>) -> Vector2<f64> {
-        let (s, c) = self.theta.sin_cos();
+        self.transform_with(self.theta.sin_cos(), p)
+    }
+
+    /// [`Pose2::transform`] with `(sin θ, cos θ)` computed once by the caller
+    /// (loops over a scan).
+    #[inline]
+    pub fn transform_with(self, (s, c): (f64, f64), p: Vector2<f64>) -> Vector2<f64> {
         Vector2::new(c * p.x - s * p.y + self.x, s * p.x + c * p.y + self.y)
     }
 

@@ -199,18 +199,23 @@ pub struct Cursor<'a, T> {
 
 impl<'a, T> Cursor<'a, T> {
     /// The value of `key`, if any (as [`CellTable::get`]).
-    #[inline]
+    #[inline(always)]
     pub fn get(&mut self, key: CellKey) -> Option<&'a T> {
         let (tile, slot) = split(key);
         let t = match self.last {
             Some((k, t)) if k == tile => t,
-            _ => {
-                let t = self.table.tiles.get(&tile).copied();
-                self.last = Some((tile, t));
-                t
-            }
+            _ => self.find_tile(tile),
         };
         self.table.value_at(t?, slot)
+    }
+
+    /// The hashed look-up of a tile other than the last one (kept out of
+    /// line, so the common path inlines into the matcher's loop).
+    #[inline(never)]
+    fn find_tile(&mut self, tile: (i32, i32)) -> Option<u32> {
+        let t = self.table.tiles.get(&tile).copied();
+        self.last = Some((tile, t));
+        t
     }
 }
 

@@ -1,0 +1,92 @@
+//! Score terms of one pyramid level already computed at a pose, kept for
+//! reuse within one match.
+//!
+//! A coarse-to-fine stage sums its own level and the next coarser one
+//! (`crate::matcher::LEVEL_WINDOW`), and starts where the previous stage
+//! ended: the coarser level's terms at that pose are the ones the previous
+//! stage computed last. Reusing them saves one pass over the scan per stage,
+//! and changes no bit (the same sums, taken from where they were computed).
+
+use crate::score::{Order, ScoreTerms};
+use crate::se2::Pose2;
+
+/// Entries kept: a stage's last few evaluations (its final pose need not be
+/// the last one evaluated: rejected line-search trials come after it).
+const CAPACITY: usize = 8;
+
+/// The last few (8) evaluations of whole-scan score terms, by level.
+#[derive(Debug, Default)]
+pub struct LevelMemo {
+    entries: Vec<(usize, Pose2, Order, ScoreTerms)>,
+    next: usize,
+}
+
+impl LevelMemo {
+    /// The terms of `level` at exactly `pose`, if computed with at least
+    /// `order` (derivatives include the value).
+    pub fn get(&self, level: usize, pose: Pose2, order: Order) -> Option<ScoreTerms> {
+        self.entries
+            .iter()
+            .find(|(l, p, o, _)| {
+                *l == level && *p == pose && (*o == order || *o == Order::Derivatives)
+            })
+            .map(|e| e.3)
+    }
+
+    /// Records the terms of `level` at `pose`.
+    pub fn put(&mut self, level: usize, pose: Pose2, order: Order, terms: ScoreTerms) {
+        let entry = (level, pose, order, terms);
+        if self.entries.len() < CAPACITY {
+            self.entries.push(entry);
+        } else {
+            self.entries[self.next] = entry;
+            self.next = (self.next + 1) % CAPACITY;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn terms(score: f64) -> ScoreTerms {
+        ScoreTerms {
+            score,
+            ..ScoreTerms::default()
+        }
+    }
+
+    #[test]
+    fn finds_exact_pose_and_level_only() {
+        let mut m = LevelMemo::default();
+        let p = Pose2::new(0.1, 0.2, 0.3);
+        m.put(2, p, Order::Value, terms(1.0));
+        assert_eq!(m.get(2, p, Order::Value).map(|t| t.score), Some(1.0));
+        // Value terms cannot stand in for derivatives.
+        assert!(m.get(2, p, Order::Derivatives).is_none());
+        assert!(m.get(1, p, Order::Value).is_none());
+        assert!(m
+            .get(2, Pose2::new(0.1, 0.2, 0.3 + 1e-15), Order::Value)
+            .is_none());
+        m.put(2, p, Order::Derivatives, terms(2.0));
+        assert_eq!(m.get(2, p, Order::Derivatives).map(|t| t.score), Some(2.0));
+    }
+
+    #[test]
+    fn forgets_the_oldest_beyond_capacity() {
+        let mut m = LevelMemo::default();
+        for i in 0..=CAPACITY {
+            m.put(
+                0,
+                Pose2::new(i as f64, 0.0, 0.0),
+                Order::Value,
+                terms(i as f64),
+            );
+        }
+        assert!(m.get(0, Pose2::new(0.0, 0.0, 0.0), Order::Value).is_none());
+        for i in 1..=CAPACITY {
+            let p = Pose2::new(i as f64, 0.0, 0.0);
+            assert_eq!(m.get(0, p, Order::Value).map(|t| t.score), Some(i as f64));
+        }
+    }
+}
