@@ -103,14 +103,33 @@ impl CellStats {
 }
 
 /// Eigen-decomposition of a symmetric 2×2 matrix in closed form: `(λ₁, λ₂, v₁)`
-/// with `λ₁ ≥ λ₂` and `v₁` the unit eigenvector of `λ₁` (`v₂ = (−v₁.y, v₁.x)`).
+/// with `λ₁ ≥ λ₂` and `v₁` the unit eigenvector of `λ₁` (`v₂ = (−v₁.y, v₁.x)`),
+/// `v₁ = (cos φ, sin φ)` with `φ = ½ atan2(2b, a − c)` in (−π/2, π/2].
+///
+/// Without trigonometry: with `t = a − c` and `r = √(t² + 4b²)`, `v₁` is
+/// along `(t + r, 2b)` for `t ≥ 0` and along `(2b, r − t)` (turned to
+/// `cos φ ≥ 0`) for `t < 0`, each free of cancellation on its side.
+/// Isotropic matrices (`r = 0`) get `v₁ = (1, 0)`.
 pub fn symmetric_eigen2(m: &Matrix2<f64>) -> (f64, f64, Vector2<f64>) {
     let (a, b, c) = (m[(0, 0)], 0.5 * (m[(0, 1)] + m[(1, 0)]), m[(1, 1)]);
     let mid = 0.5 * (a + c);
     let rad = (0.25 * (a - c) * (a - c) + b * b).sqrt();
-    let phi = 0.5 * (2.0 * b).atan2(a - c);
-    let (s, co) = phi.sin_cos();
-    (mid + rad, mid - rad, Vector2::new(co, s))
+    let t = a - c;
+    let r = 2.0 * rad;
+    let dir = if t >= 0.0 {
+        Vector2::new(t + r, 2.0 * b)
+    } else if b.is_sign_negative() {
+        Vector2::new(-2.0 * b, t - r)
+    } else {
+        Vector2::new(2.0 * b, r - t)
+    };
+    let norm = dir.norm();
+    let v1 = if norm == 0.0 {
+        Vector2::new(1.0, 0.0)
+    } else {
+        dir / norm // NaN stays NaN
+    };
+    (mid + rad, mid - rad, v1)
 }
 
 /// A cell's normal distribution as the matcher uses it: mean `q` [m, map
@@ -217,5 +236,56 @@ impl Gaussian {
         let c = &self.inverse;
         let det = c[(0, 0)] * c[(1, 1)] - c[(0, 1)] * c[(1, 0)];
         Matrix2::new(c[(1, 1)], -c[(0, 1)], -c[(1, 0)], c[(0, 0)]) / det
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The trigonometric form the closed form replaces.
+    fn by_angle(m: &Matrix2<f64>) -> Vector2<f64> {
+        let (a, b, c) = (m[(0, 0)], 0.5 * (m[(0, 1)] + m[(1, 0)]), m[(1, 1)]);
+        let (s, co) = (0.5 * (2.0 * b).atan2(a - c)).sin_cos();
+        Vector2::new(co, s)
+    }
+
+    #[test]
+    fn eigenvector_agrees_with_the_angle_form() {
+        let mut x: u64 = 3;
+        let mut next = move || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((x >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
+        };
+        let mut worst: f64 = 0.0;
+        for i in 0..200_000 {
+            let scale = 10f64.powi(i % 9 - 6);
+            let (a, c) = (next().abs() * scale, next().abs() * scale);
+            // Thin and round matrices, both signs of b and of a − c.
+            let b = next() * scale * if i % 3 == 0 { 1e-9 } else { 1.0 };
+            let m = Matrix2::new(a, b, b, c);
+            let (l1, l2, v) = symmetric_eigen2(&m);
+            let w = by_angle(&m);
+            worst = worst.max((v - w).norm());
+            // An eigenpair: M v = λ₁ v, to round-off of the largest entry.
+            let residual = (m * v - v * l1).norm();
+            assert!(residual <= 1e-14 * scale.max(l1.abs()), "{m} {residual}");
+            assert!(l1 >= l2);
+            assert!(v.x >= 0.0);
+        }
+        assert!(worst < 1e-14, "{worst}");
+    }
+
+    #[test]
+    fn eigenvector_edge_cases() {
+        let e = |a: f64, b: f64, c: f64| symmetric_eigen2(&Matrix2::new(a, b, b, c)).2;
+        assert_eq!(e(1.0, 0.0, 1.0), Vector2::new(1.0, 0.0));
+        assert_eq!(e(0.0, 0.0, 0.0), Vector2::new(1.0, 0.0));
+        assert_eq!(e(2.0, 0.0, 1.0), Vector2::new(1.0, 0.0));
+        assert_eq!(e(1.0, 0.0, 2.0), Vector2::new(0.0, 1.0));
+        assert_eq!(e(1.0, -0.0, 2.0), Vector2::new(0.0, -1.0));
+        assert!(e(f64::NAN, 0.0, 1.0).x.is_nan());
     }
 }
