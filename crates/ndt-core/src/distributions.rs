@@ -84,32 +84,64 @@ impl Distributions {
         touched: &[CellKey],
         shape: Option<Shape<'_>>,
     ) {
-        let mut affected: FxHashSet<CellKey> = match shape {
-            Some(s) => s.descendants_of_touched(cells, touched),
-            None => FxHashSet::with_capacity_and_hasher(touched.len() * 2, Default::default()),
+        let mut shapes = ShapeCache::default();
+        // With a shape level: every cell under a touched ancestor (the
+        // touched cells that still exist among them), each once.
+        let mut ancestors = FxHashSet::default();
+        if let Some(s) = shape {
+            ancestors = touched
+                .iter()
+                .map(|&k| crate::pyramid::coarse_key(k, s.depth))
+                .collect();
+            for key in s.descendants(cells, &ancestors) {
+                self.recompute(cells, cell_size, shape, &mut shapes, key);
+            }
+        }
+        // The rest: touched cells not covered above (all of them without a
+        // shape level; with one, those that lost their last point), and with
+        // fusion the minority neighbours, whose fused sums include them.
+        let covered = |k: &CellKey| match shape {
+            Some(s) => {
+                cells.contains_key(k)
+                    && ancestors.contains(&crate::pyramid::coarse_key(*k, s.depth))
+            }
+            None => false,
         };
+        let mut rest: FxHashSet<CellKey> =
+            FxHashSet::with_capacity_and_hasher(touched.len() * 2, Default::default());
         for &key in touched {
-            affected.insert(key);
+            if !covered(&key) {
+                rest.insert(key);
+            }
             if self.options.fuse_minority {
                 // Only minority neighbours use the fused sums that include `key`.
                 for dy in -1..=1 {
                     for dx in -1..=1 {
                         let n = key.offset(dx, dy);
-                        if cells.get(&n).is_some_and(|s| s.count < MIN_POINTS) {
-                            affected.insert(n);
+                        if cells.get(&n).is_some_and(|s| s.count < MIN_POINTS) && !covered(&n) {
+                            rest.insert(n);
                         }
                     }
                 }
             }
         }
-        let mut shapes = ShapeCache::default();
-        for key in affected {
-            match distribution_of(cells, cell_size, self.options, shape, &mut shapes, key) {
-                Some(g) => {
-                    self.map.insert(key, g);
-                }
-                None => self.map.remove(key),
-            }
+        for key in rest {
+            self.recompute(cells, cell_size, shape, &mut shapes, key);
+        }
+    }
+
+    /// Sets (or removes) the distribution of `key` from the sums.
+    fn recompute(
+        &mut self,
+        cells: &FxHashMap<CellKey, CellStats>,
+        cell_size: f64,
+        shape: Option<Shape<'_>>,
+        shapes: &mut ShapeCache,
+        key: CellKey,
+    ) {
+        match distribution_of(cells, cell_size, self.options, shape, shapes, key) {
+            Some(g) => self.map.insert(key, g),
+            None => self.map.remove(key),
         }
     }
 
@@ -159,8 +191,10 @@ impl Distributions {
 
 /// The covariance part of each ancestor's shaped distribution
 /// ([`Gaussian::shape_of`]), computed once per ancestor in a build or update
-/// rather than once per fine cell under it.
-type ShapeCache = FxHashMap<CellKey, Option<Gaussian>>;
+/// rather than once per fine cell under it: `None` when the ancestor has fewer
+/// than [`MIN_POINTS`] points (its cells keep their own distributions),
+/// `Some(None)` when it has no distribution.
+type ShapeCache = FxHashMap<CellKey, Option<Option<Gaussian>>>;
 
 /// The distribution of one cell under `options`, from the sums alone.
 fn distribution_of(
@@ -176,11 +210,14 @@ fn distribution_of(
     // Own mean, the ancestor's covariance (crate::shape), when the ancestor
     // has a distribution of its own (Gaussian::with_shape, bit for bit).
     if let Some(s) = shape {
-        let (at, region) = s.ancestor(key);
-        if let Some(region) = region.filter(|a| a.count >= MIN_POINTS) {
-            let covariance = shapes.entry(at).or_insert_with(|| {
-                Gaussian::shape_of(region, options.sigma_floor, options.expansion)
-            });
+        let at = crate::pyramid::coarse_key(key, s.depth);
+        let shaped = shapes.entry(at).or_insert_with(|| {
+            s.cells
+                .get(&at)
+                .filter(|a| a.count >= MIN_POINTS)
+                .map(|region| Gaussian::shape_of(region, options.sigma_floor, options.expansion))
+        });
+        if let Some(covariance) = shaped {
             return Gaussian::from_shape(own, centre, covariance.as_ref()?);
         }
     }

@@ -31,23 +31,15 @@ pub struct Shape<'a> {
 }
 
 impl<'a> Shape<'a> {
-    /// The key of the ancestor of cell `key` of the distributions' level,
-    /// and its sums if it is occupied.
-    #[inline]
-    pub fn ancestor(self, key: CellKey) -> (CellKey, Option<&'a CellStats>) {
-        let at = coarse_key(key, self.depth);
-        (at, self.cells.get(&at))
-    }
-
-    /// Every occupied cell of `cells` (the distributions' level) under the
-    /// ancestors of `touched`: their distributions change with the ancestor.
-    pub fn descendants_of_touched(
+    /// Every occupied cell of `cells` (the distributions' level) under one of
+    /// `ancestors` (keys of the shape level): their distributions change with
+    /// the ancestor. Each cell once (a cell has one ancestor), in no
+    /// particular order.
+    pub fn descendants(
         &self,
         cells: &FxHashMap<CellKey, CellStats>,
-        touched: &[CellKey],
-    ) -> FxHashSet<CellKey> {
-        let ancestors: FxHashSet<CellKey> =
-            touched.iter().map(|&k| coarse_key(k, self.depth)).collect();
+        ancestors: &FxHashSet<CellKey>,
+    ) -> Vec<CellKey> {
         let side = 1u64 << self.depth.min(31);
         let lookups = (side * side).saturating_mul(ancestors.len() as u64);
         if lookups >= cells.len() as u64 {
@@ -58,7 +50,7 @@ impl<'a> Shape<'a> {
                 .copied()
                 .collect();
         }
-        let mut out = FxHashSet::with_capacity_and_hasher(touched.len() * 4, Default::default());
+        let mut out = Vec::with_capacity(ancestors.len() * 16);
         let side = side as i32; // < 2^16 here: side² < cells.len()
         for a in ancestors {
             // The ancestor's square of `side × side` cells on this level.
@@ -70,7 +62,7 @@ impl<'a> Shape<'a> {
                         iy: y0 + dy,
                     };
                     if cells.contains_key(&k) {
-                        out.insert(k);
+                        out.push(k);
                     }
                 }
             }

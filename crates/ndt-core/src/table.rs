@@ -56,6 +56,8 @@ pub struct CellTable<T> {
     used: Vec<u32>,
     free_tiles: Vec<u32>,
     values: Vec<(CellKey, T)>,
+    /// The tile of the last insert (runs of inserts in one tile skip the hash).
+    last_insert: Option<((i32, i32), u32)>,
 }
 
 impl<T> Default for CellTable<T> {
@@ -66,6 +68,7 @@ impl<T> Default for CellTable<T> {
             used: Vec::new(),
             free_tiles: Vec::new(),
             values: Vec::new(),
+            last_insert: None,
         }
     }
 }
@@ -109,8 +112,9 @@ impl<T> CellTable<T> {
     /// Sets the value of `key` (replacing any).
     pub fn insert(&mut self, key: CellKey, value: T) {
         let (tile, slot) = split(key);
-        let t = match self.tiles.get(&tile) {
-            Some(&t) => t,
+        let cached = self.last_insert.filter(|&(k, _)| k == tile).map(|(_, t)| t);
+        let t = match cached.or_else(|| self.tiles.get(&tile).copied()) {
+            Some(t) => t,
             None => {
                 let t = match self.free_tiles.pop() {
                     Some(t) => t,
@@ -124,6 +128,7 @@ impl<T> CellTable<T> {
                 t
             }
         };
+        self.last_insert = Some((tile, t));
         let i = &mut self.slots[t as usize][slot];
         if *i == EMPTY {
             *i = self.values.len() as u32;
@@ -148,6 +153,7 @@ impl<T> CellTable<T> {
         self.used[t as usize] -= 1;
         if self.used[t as usize] == 0 {
             self.tiles.remove(&tile);
+            self.last_insert = None;
             self.free_tiles.push(t);
         }
         // Keep the values contiguous: move the last one into the hole.
