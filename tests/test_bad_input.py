@@ -630,7 +630,7 @@ ODOMETRY_CONFIG_CASES = [
         "rotation_step: expected a finite angle > 0 rad, at least rotation_search / 1000, got 0",
     ),
     (
-        {"rotation_step": 1e-6},
+        {"rotation_search": 0.17, "rotation_step": 1e-6},
         "rotation_step: expected a finite angle > 0 rad, at least rotation_search / 1000, "
         "got 0.000001",
     ),

@@ -118,7 +118,7 @@ def test_bad_input_is_rejected_and_leaves_the_loop_unchanged() -> None:
     with pytest.raises(ValueError, match="max_range"):
         ndtgrid.Odometry(config=ndtgrid.OdometryConfig(max_range=-1.0))
     with pytest.raises(ValueError, match="rotation_step"):
-        ndtgrid.Odometry(config=ndtgrid.OdometryConfig(rotation_step=1e-9))
+        ndtgrid.Odometry(config=ndtgrid.OdometryConfig(rotation_search=0.17, rotation_step=1e-9))
     with pytest.raises(ValueError, match="cell_size"):
         ndtgrid.Odometry(cell_size=0.0)
     with pytest.raises(TypeError, match="OdometryConfig"):

@@ -59,7 +59,12 @@ pub struct OdometryConfig {
     /// \[rad\] (0 = off): the score of eq. (1) is evaluated at the prediction
     /// turned by `±rotation_step, ±2·rotation_step, …` up to this, and Newton
     /// starts from the best. A 2 cm map's basin is narrow in rotation (1° moves
-    /// a point 5 m away by 9 cm), and wheel odometry is worst in turns.
+    /// a point 5 m away by 9 cm), and wheel odometry is worst in turns. Off
+    /// by default since the match's own rotational multi-start
+    /// ([`MatchOptions::rotation_search`], ±0.15 rad from run centroids) covers
+    /// the same turns: on the five benchmark logs `±10°` in 1° steps gave the
+    /// same relation errors to 0.1 mm or better (BENCHMARK.md, "Datasets") at
+    /// 23–31 % more time per scan.
     pub rotation_search: f64,
     /// Step of that search \[rad\].
     pub rotation_step: f64,
@@ -110,7 +115,7 @@ impl Default for OdometryConfig {
             insert_angle: 5f64.to_radians(),
             map_window: 200,
             min_match_ratio: 0.3,
-            rotation_search: 10f64.to_radians(),
+            rotation_search: 0.0,
             rotation_step: 1f64.to_radians(),
             prior_gap_distance: 0.1,
             prior_gap_angle: 5f64.to_radians(),
