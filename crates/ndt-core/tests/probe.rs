@@ -18,8 +18,8 @@ fn the_probe_admits_every_occupied_cell_and_rules_out_empty_blocks() {
     grid.remove_cells(&keys[..keys.len() / 3]);
     let mut probe = grid.occupancy_probe();
     let (mut ruled_out, mut empty) = (0, 0);
-    for ix in -60..60 {
-        for iy in -60..60 {
+    for ix in -120..120 {
+        for iy in -120..120 {
             let key = CellKey { ix, iy };
             let may = probe.may_hold(key);
             if grid.stats(key).is_some() {
@@ -30,7 +30,7 @@ fn the_probe_admits_every_occupied_cell_and_rules_out_empty_blocks() {
             }
         }
     }
-    // Outside the ±1 m square every 8 × 8 block is empty.
+    // Blocks (16 × 16 cells) beyond the ±1 m square are empty.
     assert!(
         ruled_out * 3 > empty,
         "{ruled_out} of {empty} empty cells ruled out"

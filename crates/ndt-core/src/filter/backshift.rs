@@ -7,7 +7,7 @@
 
 use nalgebra::Vector2;
 
-use crate::filter::raywalk::walk_cells_in;
+use crate::filter::raywalk::walk_cells_in_skipping;
 use crate::grid::NdtGrid;
 use crate::key::CellKey;
 
@@ -37,12 +37,19 @@ pub fn former_cell_short_of(
     };
     let mut found = false;
     let mut probe = grid.occupancy_probe();
-    walk_cells_in(start, hit, cell_size, grid.key_bounds(), |key, _, _| {
-        if key != hit_key && probe.may_hold(key) && grid.stats(key).is_some() {
-            found = true;
-        }
-        !found
-    });
+    walk_cells_in_skipping(
+        start,
+        hit,
+        cell_size,
+        grid.key_bounds(),
+        &mut grid.occupancy_probe(),
+        |key, _, _| {
+            if key != hit_key && probe.may_hold(key) && grid.stats(key).is_some() {
+                found = true;
+            }
+            !found
+        },
+    );
     found
 }
 

@@ -22,7 +22,7 @@ use rustc_hash::FxHashMap;
 
 use crate::filter::areas::Area;
 use crate::filter::observation::CellTable;
-use crate::filter::raywalk::walk_cells_in;
+use crate::filter::raywalk::walk_cells_in_skipping;
 use crate::filter::Beam;
 use crate::grid::NdtGrid;
 use crate::key::CellKey;
@@ -104,11 +104,12 @@ pub fn passed_cells(
     let reach = range - margin;
     let cell_size = grid.cell_size();
     let mut probe = grid.occupancy_probe();
-    walk_cells_in(
+    walk_cells_in_skipping(
         sensor,
         sensor + dir * reach,
         cell_size,
         grid.key_bounds(),
+        &mut grid.occupancy_probe(),
         |key, _, _| {
             if !probe.may_hold(key) {
                 return true;

@@ -19,7 +19,40 @@ pub fn walk_cells(
     cell_size: f64,
     visit: impl FnMut(CellKey, f64, f64) -> bool,
 ) {
-    walk_until(from, to, cell_size, f64::INFINITY, visit);
+    walk_until(from, to, cell_size, f64::INFINITY, &mut NoSkip, visit);
+}
+
+/// Square blocks of `2^bits × 2^bits` cells that a walk may cross without
+/// visiting their cells (see [`walk_cells_in_skipping`]).
+pub trait EmptyBlocks {
+    /// log2 of the block side \[cells\]; `None`: no block is skipped.
+    fn block_bits(&self) -> Option<u32>;
+    /// `true` when the block of cell `key` holds no cell the visitor would
+    /// act on.
+    fn is_empty(&mut self, key: CellKey) -> bool;
+}
+
+/// The blocks a grid's pyramid shows empty ([`crate::grid::OccupancyProbe`]).
+impl EmptyBlocks for crate::grid::OccupancyProbe<'_> {
+    fn block_bits(&self) -> Option<u32> {
+        crate::grid::OccupancyProbe::block_bits(self)
+    }
+    fn is_empty(&mut self, key: CellKey) -> bool {
+        !self.may_hold(key)
+    }
+}
+
+/// Skips nothing.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoSkip;
+
+impl EmptyBlocks for NoSkip {
+    fn block_bits(&self) -> Option<u32> {
+        None
+    }
+    fn is_empty(&mut self, _: CellKey) -> bool {
+        false
+    }
 }
 
 /// [`walk_cells`] restricted to the cells of `region` (see
@@ -38,6 +71,25 @@ pub fn walk_cells_in(
     to: Vector2<f64>,
     cell_size: f64,
     region: Option<KeyBounds>,
+    visit: impl FnMut(CellKey, f64, f64) -> bool,
+) {
+    walk_cells_in_skipping(from, to, cell_size, region, &mut NoSkip, visit);
+}
+
+/// [`walk_cells_in`] that crosses the blocks `skip` reports empty without
+/// visiting their cells. For a visitor that does nothing and returns `true`
+/// on those cells it is the same walk: the traversal's state after a skipped
+/// block is the one the cell-by-cell walk reaches there, to the bit (the same
+/// sums, formed in the same order), so every cell outside them is visited
+/// with the same distances. The block holding the end point is walked cell
+/// by cell. A beam through free space then costs a few additions per block
+/// instead of a visit per cell (the §V walks, [`crate::filter::confirmation`]).
+pub fn walk_cells_in_skipping(
+    from: Vector2<f64>,
+    to: Vector2<f64>,
+    cell_size: f64,
+    region: Option<KeyBounds>,
+    skip: &mut impl EmptyBlocks,
     visit: impl FnMut(CellKey, f64, f64) -> bool,
 ) {
     let Some(region) = region else {
@@ -77,19 +129,28 @@ pub fn walk_cells_in(
     }
     let length = delta.norm();
     if t0 > 0.0 {
-        walk_until(from + delta * t0, to, cell_size, (t1 - t0) * length, visit);
+        walk_until(
+            from + delta * t0,
+            to,
+            cell_size,
+            (t1 - t0) * length,
+            skip,
+            visit,
+        );
     } else {
-        walk_until(from, to, cell_size, t1 * length, visit);
+        walk_until(from, to, cell_size, t1 * length, skip, visit);
     }
 }
 
 /// [`walk_cells`], stopping before the first cell entered farther than
-/// `stop` \[m\] from `from`.
+/// `stop` \[m\] from `from`, crossing the empty blocks of `skip` (see
+/// [`walk_cells_in_skipping`]).
 fn walk_until(
     from: Vector2<f64>,
     to: Vector2<f64>,
     cell_size: f64,
     stop: f64,
+    skip: &mut impl EmptyBlocks,
     mut visit: impl FnMut(CellKey, f64, f64) -> bool,
 ) {
     let inv = 1.0 / cell_size;
@@ -123,10 +184,74 @@ fn walk_until(
     let budget = (i64::from(last.ix) - i64::from(key.ix)).unsigned_abs()
         + (i64::from(last.iy) - i64::from(key.iy)).unsigned_abs()
         + 2;
+    let bits = skip.block_bits().filter(|&b| b < 31);
+    let block_of = |k: CellKey, b: u32| (k.ix >> b, k.iy >> b);
     let mut t_in = 0.0;
-    for _ in 0..budget {
+    let mut walked: u64 = 0;
+    while walked < budget {
         if t_in > stop {
             return;
+        }
+        if let Some(b) = bits {
+            if block_of(key, b) != block_of(last, b) && skip.is_empty(key) {
+                // Cross the block as the loop below would, without visits:
+                // `n` steps along an axis leave the block, and the axis whose
+                // last in-block crossing comes first (x on a tie, as below)
+                // is the one the walk leaves by.
+                let side = 1i32 << b;
+                let exits = |step: i32, index: i32| -> u64 {
+                    let lo = (index >> b) << b;
+                    match step {
+                        1 => (lo + side - index) as u64,
+                        -1 => (index - lo + 1) as u64,
+                        _ => u64::MAX,
+                    }
+                };
+                let (nx, ny) = (exits(step_x, key.ix), exits(step_y, key.iy));
+                // Distance of the n-th crossing after `start`, summed step by
+                // step as the loop does.
+                let after = |start: f64, d: f64, n: u64| (0..n).fold(start, |v, _| v + d);
+                let by_x = match (nx, ny) {
+                    (u64::MAX, _) => false,
+                    (_, u64::MAX) => true,
+                    _ => after(next_x, delta_x, nx - 1) <= after(next_y, delta_y, ny - 1),
+                };
+                let (mut x, mut y) = (next_x, next_y);
+                let (mut sx, mut sy) = (0u64, 0u64);
+                if by_x {
+                    let xe = after(next_x, delta_x, nx - 1);
+                    while y < xe {
+                        y += delta_y;
+                        sy += 1;
+                    }
+                    x = xe;
+                    sx = nx - 1;
+                } else {
+                    let ye = after(next_y, delta_y, ny - 1);
+                    while x <= ye {
+                        x += delta_x;
+                        sx += 1;
+                    }
+                    y = ye;
+                    sy = ny - 1;
+                }
+                // (x, y): the crossing distances in the block's last cell; its
+                // exit distance, then the step out.
+                t_in = x.min(y).min(length);
+                if by_x {
+                    x += delta_x;
+                    sx += 1;
+                } else {
+                    y += delta_y;
+                    sy += 1;
+                }
+                key.ix += step_x * sx as i32;
+                key.iy += step_y * sy as i32;
+                next_x = x;
+                next_y = y;
+                walked += sx + sy;
+                continue;
+            }
         }
         let t_out = next_x.min(next_y).min(length);
         // Walk until the end point's own cell, even when the segment only
@@ -142,6 +267,7 @@ fn walk_until(
             next_y += delta_y;
         }
         t_in = t_out;
+        walked += 1;
     }
 }
 
@@ -275,5 +401,107 @@ mod tests {
             },
         );
         assert_eq!(n, 0);
+    }
+
+    /// Blocks of 8 × 8 cells, empty by a fixed pseudo-random rule.
+    struct Oracle(u32);
+
+    impl Oracle {
+        fn empty(&self, key: CellKey) -> bool {
+            let (bx, by) = (key.ix >> 3, key.iy >> 3);
+            let h = (bx as u32)
+                .wrapping_mul(0x9E37_79B9)
+                .wrapping_add((by as u32).wrapping_mul(0x85EB_CA6B))
+                .rotate_left(13);
+            h % 5 < self.0
+        }
+    }
+
+    impl EmptyBlocks for Oracle {
+        fn block_bits(&self) -> Option<u32> {
+            Some(3)
+        }
+        fn is_empty(&mut self, key: CellKey) -> bool {
+            self.empty(key)
+        }
+    }
+
+    /// Skipping empty blocks visits every other cell in the same order, with
+    /// the same distances to the bit, and stops where the cell-by-cell walk
+    /// stops.
+    #[test]
+    fn skipping_empty_blocks_visits_the_other_cells_exactly() {
+        let mut seed: u64 = 5;
+        let mut next = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
+        };
+        let cell = 0.02;
+        let region =
+            KeyBounds::of(CellKey { ix: -900, iy: -900 }).including(CellKey { ix: 900, iy: 900 });
+        let mut skipped_any = false;
+        for case in 0..5000u32 {
+            let oracle = Oracle(case / 5 % 5);
+            let mut a = Vector2::new(10.0 * next(), 10.0 * next());
+            // Axis-parallel, diagonal and general directions, short and long;
+            // from cell centres along slopes ±1, ±2, ±1/2, where crossings of
+            // the two axes tie exactly.
+            let b = match case % 5 {
+                0 => a + Vector2::new(20.0 * next(), 0.0),
+                1 => a + Vector2::new(0.0, 20.0 * next()),
+                2 => {
+                    let d = 20.0 * next();
+                    a + Vector2::new(d, d)
+                }
+                3 => {
+                    a = Vector2::new((a.x / cell).floor() + 0.5, (a.y / cell).floor() + 0.5) * cell;
+                    let (sx, sy) = [
+                        (1.0, 1.0),
+                        (1.0, -1.0),
+                        (-1.0, 2.0),
+                        (2.0, -1.0),
+                        (-2.0, -1.0),
+                    ][case as usize / 5 % 5];
+                    a + Vector2::new(sx, sy) * (cell * f64::from(30 + case % 400))
+                }
+                _ => Vector2::new(40.0 * next(), 40.0 * next()),
+            };
+            // Stop at the n-th visited cell outside the empty blocks.
+            let stop_after = if case % 3 == 0 {
+                1 + case as usize % 40
+            } else {
+                usize::MAX
+            };
+            let last = CellKey::of(b, 1.0 / cell).unwrap();
+            let keep = |k: &CellKey| {
+                !oracle.empty(*k) || (k.ix >> 3, k.iy >> 3) == (last.ix >> 3, last.iy >> 3)
+            };
+            let run = |skip: &mut dyn FnMut() -> Option<Oracle>| {
+                let mut out = Vec::new();
+                let mut n = 0;
+                let mut visit = |k: CellKey, t0: f64, t1: f64| {
+                    if !keep(&k) {
+                        return true;
+                    }
+                    out.push((k, t0.to_bits(), t1.to_bits()));
+                    n += 1;
+                    n < stop_after
+                };
+                match skip() {
+                    Some(mut o) => {
+                        walk_cells_in_skipping(a, b, cell, Some(region), &mut o, &mut visit)
+                    }
+                    None => walk_cells_in(a, b, cell, Some(region), &mut visit),
+                }
+                out
+            };
+            let want = run(&mut || None);
+            let got = run(&mut || Some(Oracle(case / 5 % 5)));
+            assert_eq!(got, want, "case {case}: {a:?} -> {b:?}");
+            skipped_any |= case / 5 % 5 > 0 && !want.is_empty();
+        }
+        assert!(skipped_any);
     }
 }
