@@ -48,7 +48,7 @@ pub fn hash_map_bytes(capacity: usize, entry: usize) -> usize {
 }
 
 /// Values of type `T` keyed by [`CellKey`], in tiles (see the module docs).
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct CellTable<T> {
     tiles: FxHashMap<(i32, i32), u32>,
     slots: Vec<Tile>,
@@ -58,6 +58,26 @@ pub struct CellTable<T> {
     values: Vec<(CellKey, T)>,
     /// The tile of the last insert (runs of inserts in one tile skip the hash).
     last_insert: Option<((i32, i32), u32)>,
+}
+
+/// A copy with the original's spare capacity: inserts into a clone grow
+/// its vectors as they would the original's (amortised), instead of the
+/// first insert after cloning reallocating and copying every value.
+impl<T: Clone> Clone for CellTable<T> {
+    fn clone(&self) -> Self {
+        let mut values = Vec::with_capacity(self.values.capacity());
+        values.extend_from_slice(&self.values);
+        let mut slots = Vec::with_capacity(self.slots.capacity());
+        slots.extend_from_slice(&self.slots);
+        Self {
+            tiles: self.tiles.clone(),
+            slots,
+            used: self.used.clone(),
+            free_tiles: self.free_tiles.clone(),
+            values,
+            last_insert: self.last_insert,
+        }
+    }
 }
 
 impl<T> Default for CellTable<T> {
