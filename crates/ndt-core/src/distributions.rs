@@ -107,11 +107,19 @@ impl Distributions {
             }
             None => false,
         };
-        let mut rest: FxHashSet<CellKey> =
+        // In the order met (a scan's cells come in runs along its surfaces,
+        // so consecutive inserts mostly share a tile of the table).
+        let mut seen: FxHashSet<CellKey> =
             FxHashSet::with_capacity_and_hasher(touched.len() * 2, Default::default());
+        let mut rest = Vec::with_capacity(touched.len() * 2);
+        let mut add = |k: CellKey| {
+            if seen.insert(k) {
+                rest.push(k);
+            }
+        };
         for &key in touched {
             if !covered(&key) {
-                rest.insert(key);
+                add(key);
             }
             if self.options.fuse_minority {
                 // Only minority neighbours use the fused sums that include `key`.
@@ -119,7 +127,7 @@ impl Distributions {
                     for dx in -1..=1 {
                         let n = key.offset(dx, dy);
                         if cells.get(&n).is_some_and(|s| s.count < MIN_POINTS) && !covered(&n) {
-                            rest.insert(n);
+                            add(n);
                         }
                     }
                 }
