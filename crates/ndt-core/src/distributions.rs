@@ -61,7 +61,7 @@ impl Distributions {
             options,
             level,
             cell_size,
-            shape_depth: shape.map_or(0, |s| s.depth),
+            shape_depth: shape.map_or(0, |s| s.depth()),
             map,
         }
     }
@@ -91,9 +91,9 @@ impl Distributions {
         if let Some(s) = shape {
             ancestors = touched
                 .iter()
-                .map(|&k| crate::pyramid::coarse_key(k, s.depth))
+                .map(|&k| crate::pyramid::coarse_key(k, s.depth()))
                 .collect();
-            for key in s.descendants(cells, &ancestors) {
+            for key in s.descendants(&ancestors) {
                 self.recompute(cells, cell_size, shape, &mut shapes, key);
             }
         }
@@ -103,7 +103,7 @@ impl Distributions {
         let covered = |k: &CellKey| match shape {
             Some(s) => {
                 cells.contains_key(k)
-                    && ancestors.contains(&crate::pyramid::coarse_key(*k, s.depth))
+                    && ancestors.contains(&crate::pyramid::coarse_key(*k, s.depth()))
             }
             None => false,
         };
@@ -218,9 +218,9 @@ fn distribution_of(
     // Own mean, the ancestor's covariance (crate::shape), when the ancestor
     // has a distribution of its own (Gaussian::with_shape, bit for bit).
     if let Some(s) = shape {
-        let at = crate::pyramid::coarse_key(key, s.depth);
+        let at = crate::pyramid::coarse_key(key, s.depth());
         let shaped = shapes.entry(at).or_insert_with(|| {
-            s.cells
+            s.cells()
                 .get(&at)
                 .filter(|a| a.count >= MIN_POINTS)
                 .map(|region| Gaussian::shape_of(region, options.sigma_floor, options.expansion))

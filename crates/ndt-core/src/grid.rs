@@ -378,10 +378,7 @@ fn shape_at(pyramid: &Pyramid, level: usize, depth: usize) -> Option<Shape<'_>> 
     if depth == 0 {
         return None;
     }
-    pyramid.level(level + depth).map(|lv| Shape {
-        cells: lv.cells(),
-        depth,
-    })
+    pyramid.levels(level..=level + depth).and_then(Shape::new)
 }
 
 /// Rejects non-finite points.

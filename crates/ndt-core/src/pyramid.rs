@@ -87,6 +87,11 @@ impl Pyramid {
         self.levels.get(l)
     }
 
+    /// Levels `range` (0 = fine), if the pyramid has them all.
+    pub fn levels(&self, range: std::ops::RangeInclusive<usize>) -> Option<&[Level]> {
+        self.levels.get(range)
+    }
+
     /// The fine level.
     pub fn fine(&self) -> &Level {
         &self.levels[0]

@@ -19,50 +19,64 @@ use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::cell::CellStats;
 use crate::key::CellKey;
-use crate::pyramid::coarse_key;
+use crate::pyramid::Level;
 
 /// The ancestors a level's distributions take their covariance from.
 #[derive(Debug, Clone, Copy)]
 pub struct Shape<'a> {
-    /// The cells of the shape level (sums about their centres).
-    pub cells: &'a FxHashMap<CellKey, CellStats>,
-    /// Levels between the distributions' level and the shape level (≥ 1).
-    pub depth: usize,
+    /// The pyramid levels from the distributions' level (first) up to the
+    /// shape level (last).
+    levels: &'a [Level],
+    /// The shape level.
+    top: &'a Level,
 }
 
 impl<'a> Shape<'a> {
-    /// Every occupied cell of `cells` (the distributions' level) under one of
+    /// The shape of the first of `levels` taken from the last (consecutive
+    /// pyramid levels); `None` with fewer than two levels.
+    pub fn new(levels: &'a [Level]) -> Option<Self> {
+        let top = levels.last().filter(|_| levels.len() >= 2)?;
+        Some(Self { levels, top })
+    }
+
+    /// Levels between the distributions' level and the shape level (≥ 1).
+    pub fn depth(&self) -> usize {
+        self.levels.len() - 1
+    }
+
+    /// The cells of the shape level (sums about their centres).
+    pub fn cells(&self) -> &'a FxHashMap<CellKey, CellStats> {
+        self.top.cells()
+    }
+
+    /// Every occupied cell of the distributions' level under one of
     /// `ancestors` (keys of the shape level): their distributions change with
-    /// the ancestor. Each cell once (a cell has one ancestor), in no
-    /// particular order.
-    pub fn descendants(
-        &self,
-        cells: &FxHashMap<CellKey, CellStats>,
-        ancestors: &FxHashSet<CellKey>,
-    ) -> Vec<CellKey> {
-        let side = 1u64 << self.depth.min(31);
-        let lookups = (side * side).saturating_mul(ancestors.len() as u64);
-        if lookups >= cells.len() as u64 {
-            // Cheaper to test every cell of the level once.
-            return cells
-                .keys()
-                .filter(|&&k| ancestors.contains(&coarse_key(k, self.depth)))
-                .copied()
-                .collect();
-        }
+    /// the ancestor. Found by descending the pyramid from each ancestor
+    /// through the occupied children only (every occupied fine cell has all
+    /// its ancestors), in Z order within an ancestor, so consecutive cells
+    /// mostly share a tile of the distributions' table. Each cell once.
+    pub fn descendants(&self, ancestors: &FxHashSet<CellKey>) -> Vec<CellKey> {
+        let depth = self.depth();
         let mut out = Vec::with_capacity(ancestors.len() * 16);
-        let side = side as i32; // < 2^16 here: side² < cells.len()
-        for a in ancestors {
-            // The ancestor's square of `side × side` cells on this level.
-            let (x0, y0) = (a.ix << self.depth, a.iy << self.depth);
-            for dy in 0..side {
-                for dx in 0..side {
-                    let k = CellKey {
-                        ix: x0 + dx,
-                        iy: y0 + dy,
+        let mut stack: Vec<(usize, CellKey)> = Vec::with_capacity(4 * depth + 1);
+        for &a in ancestors {
+            if !self.cells().contains_key(&a) {
+                continue;
+            }
+            stack.push((depth, a));
+            while let Some((i, k)) = stack.pop() {
+                let Some(below) = i.checked_sub(1).and_then(|b| self.levels.get(b)) else {
+                    out.push(k);
+                    continue;
+                };
+                // Pushed in reverse, visited (0,0), (1,0), (0,1), (1,1).
+                for (dx, dy) in [(1, 1), (0, 1), (1, 0), (0, 0)] {
+                    let c = CellKey {
+                        ix: 2 * k.ix + dx,
+                        iy: 2 * k.iy + dy,
                     };
-                    if cells.contains_key(&k) {
-                        out.push(k);
+                    if below.cells().contains_key(&c) {
+                        stack.push((i - 1, c));
                     }
                 }
             }

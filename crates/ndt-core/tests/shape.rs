@@ -7,6 +7,7 @@ mod common;
 use nalgebra::Vector2;
 use ndt_core::cell::{symmetric_eigen2, CellStats};
 use ndt_core::distributions::{DistOptions, Distributions};
+use ndt_core::pyramid::Level;
 use ndt_core::shape::Shape;
 use ndt_core::{CellKey, MatchOptions, NdtGrid, Pose2};
 
@@ -33,10 +34,10 @@ fn a_one_point_cell_on_a_wall_takes_the_walls_orientation_and_keeps_its_mean() {
         shape_cell,
     };
     let plain = Distributions::build(fine.cells(), cell, 0, options(0.0), None);
-    let shape = Shape {
-        cells: region.cells(),
-        depth: 4,
-    };
+    let levels: Vec<Level> = (0..=4).map(|l| grid.level(l).unwrap().clone()).collect();
+    let shape = Shape::new(&levels).unwrap();
+    assert_eq!(shape.depth(), 4);
+    assert_eq!(shape.cells().len(), region.cells().len());
     let shaped = Distributions::build(fine.cells(), cell, 0, options(0.32), Some(shape));
     let key = CellKey::of(Vector2::new(wall[3][0], wall[3][1]), 1.0 / cell).unwrap();
     assert_eq!(fine.cells()[&key].count, 1);
@@ -99,4 +100,46 @@ fn shaped_distributions_stay_equal_to_a_fresh_build_under_inserts_and_removals()
         grid.match_scan(&probe, at, &options).unwrap(),
         fresh.match_scan(&probe, at, &options).unwrap()
     );
+}
+
+/// `Shape::descendants` finds exactly the occupied fine cells under the given
+/// ancestors (against a filter over every fine cell), each once, after inserts
+/// and removals.
+#[test]
+fn descendants_are_the_occupied_cells_under_the_ancestors() {
+    let mut grid = NdtGrid::new(0.02).unwrap();
+    let mut seed: u64 = 9;
+    let mut next = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
+    };
+    for i in 0..6 {
+        let pts: Vec<[f64; 2]> = (0..300).map(|_| [4.0 * next(), 4.0 * next()]).collect();
+        grid.insert(&pts, Pose2::new(0.3 * f64::from(i), 0.0, 0.1)).unwrap();
+    }
+    let mut keys: Vec<CellKey> = grid.keys().collect();
+    keys.sort_unstable();
+    grid.remove_cells(&keys[..keys.len() / 4]);
+    for depth in 1..=4usize {
+        let levels: Vec<Level> = (0..=depth).map(|l| grid.level(l).unwrap().clone()).collect();
+        let shape = Shape::new(&levels).unwrap();
+        // Every other ancestor of the shape level, plus one with no cell.
+        let mut ancestors: rustc_hash::FxHashSet<CellKey> =
+            shape.cells().keys().copied().step_by(2).collect();
+        ancestors.insert(CellKey { ix: 10_000, iy: 10_000 });
+        let mut got = shape.descendants(&ancestors);
+        let n = got.len();
+        got.sort_unstable();
+        got.dedup();
+        assert_eq!(got.len(), n, "a cell listed twice");
+        let mut want: Vec<CellKey> = grid
+            .keys()
+            .filter(|k| ancestors.contains(&ndt_core::pyramid::coarse_key(*k, depth)))
+            .collect();
+        want.sort_unstable();
+        assert!(!want.is_empty());
+        assert_eq!(got, want, "depth {depth}");
+    }
 }
