@@ -93,8 +93,29 @@ impl Distributions {
                 .iter()
                 .map(|&k| crate::pyramid::coarse_key(k, s.depth()))
                 .collect();
-            for key in s.descendants(&ancestors) {
-                self.recompute(cells, cell_size, shape, &mut shapes, key);
+            // Each ancestor's shape once, then its cells (as distribution_of
+            // would give them; cells of an ancestor without a shape of its
+            // own take the paper's distribution there).
+            let mut current: Option<(CellKey, Option<Option<Gaussian>>)> = None;
+            for (ancestor, key, own) in s.descendants(&ancestors) {
+                let shaped = match current {
+                    Some((a, shaped)) if a == ancestor => shaped,
+                    _ => {
+                        let shaped = shape_of_ancestor(s, ancestor, self.options);
+                        current = Some((ancestor, shaped));
+                        shaped
+                    }
+                };
+                match shaped {
+                    Some(covariance) => {
+                        let centre = key.center(cell_size);
+                        match covariance.and_then(|c| Gaussian::from_shape(own, centre, &c)) {
+                            Some(g) => self.map.insert(key, g),
+                            None => self.map.remove(key),
+                        }
+                    }
+                    None => self.recompute(cells, cell_size, shape, &mut shapes, key),
+                }
             }
         }
         // The rest: touched cells not covered above (all of them without a
@@ -204,6 +225,15 @@ impl Distributions {
 /// `Some(None)` when it has no distribution.
 type ShapeCache = FxHashMap<CellKey, Option<Option<Gaussian>>>;
 
+/// The covariance part of the shaped distributions under ancestor `at` (see
+/// [`ShapeCache`] for the two levels of `None`).
+fn shape_of_ancestor(s: Shape<'_>, at: CellKey, options: DistOptions) -> Option<Option<Gaussian>> {
+    s.cells()
+        .get(&at)
+        .filter(|a| a.count >= MIN_POINTS)
+        .map(|region| Gaussian::shape_of(region, options.sigma_floor, options.expansion))
+}
+
 /// The distribution of one cell under `options`, from the sums alone.
 fn distribution_of(
     cells: &FxHashMap<CellKey, CellStats>,
@@ -219,12 +249,9 @@ fn distribution_of(
     // has a distribution of its own (Gaussian::with_shape, bit for bit).
     if let Some(s) = shape {
         let at = crate::pyramid::coarse_key(key, s.depth());
-        let shaped = shapes.entry(at).or_insert_with(|| {
-            s.cells()
-                .get(&at)
-                .filter(|a| a.count >= MIN_POINTS)
-                .map(|region| Gaussian::shape_of(region, options.sigma_floor, options.expansion))
-        });
+        let shaped = shapes
+            .entry(at)
+            .or_insert_with(|| shape_of_ancestor(s, at, options));
         if let Some(covariance) = shaped {
             return Gaussian::from_shape(own, centre, covariance.as_ref()?);
         }

@@ -50,12 +50,16 @@ impl<'a> Shape<'a> {
     }
 
     /// Every occupied cell of the distributions' level under one of
-    /// `ancestors` (keys of the shape level): their distributions change with
-    /// the ancestor. Found by descending the pyramid from each ancestor
-    /// through the occupied children only (every occupied fine cell has all
-    /// its ancestors), in Z order within an ancestor, so consecutive cells
-    /// mostly share a tile of the distributions' table. Each cell once.
-    pub fn descendants(&self, ancestors: &FxHashSet<CellKey>) -> Vec<CellKey> {
+    /// `ancestors` (keys of the shape level), as `(ancestor, cell, its sums)`:
+    /// their distributions change with the ancestor. Found by descending the
+    /// pyramid from each ancestor through the occupied children only (every
+    /// occupied fine cell has all its ancestors); grouped by ancestor, in Z
+    /// order within one, so consecutive cells mostly share a tile of the
+    /// distributions' table. Each cell once.
+    pub fn descendants(
+        &self,
+        ancestors: &FxHashSet<CellKey>,
+    ) -> Vec<(CellKey, CellKey, &'a CellStats)> {
         let depth = self.depth();
         let mut out = Vec::with_capacity(ancestors.len() * 16);
         let mut stack: Vec<(usize, CellKey)> = Vec::with_capacity(4 * depth + 1);
@@ -66,17 +70,24 @@ impl<'a> Shape<'a> {
             stack.push((depth, a));
             while let Some((i, k)) = stack.pop() {
                 let Some(below) = i.checked_sub(1).and_then(|b| self.levels.get(b)) else {
-                    out.push(k);
                     continue;
                 };
-                // Pushed in reverse, visited (0,0), (1,0), (0,1), (1,1).
-                for (dx, dy) in [(1, 1), (0, 1), (1, 0), (0, 0)] {
-                    let c = CellKey {
-                        ix: 2 * k.ix + dx,
-                        iy: 2 * k.iy + dy,
-                    };
-                    if below.cells().contains_key(&c) {
-                        stack.push((i - 1, c));
+                let child = |(dx, dy): (i32, i32)| CellKey {
+                    ix: 2 * k.ix + dx,
+                    iy: 2 * k.iy + dy,
+                };
+                if i == 1 {
+                    for c in [(0, 0), (1, 0), (0, 1), (1, 1)].map(child) {
+                        if let Some(stats) = below.cells().get(&c) {
+                            out.push((a, c, stats));
+                        }
+                    }
+                } else {
+                    // Pushed in reverse: visited (0,0), (1,0), (0,1), (1,1).
+                    for c in [(1, 1), (0, 1), (1, 0), (0, 0)].map(child) {
+                        if below.cells().contains_key(&c) {
+                            stack.push((i - 1, c));
+                        }
                     }
                 }
             }

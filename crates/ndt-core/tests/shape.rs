@@ -117,19 +117,30 @@ fn descendants_are_the_occupied_cells_under_the_ancestors() {
     };
     for i in 0..6 {
         let pts: Vec<[f64; 2]> = (0..300).map(|_| [4.0 * next(), 4.0 * next()]).collect();
-        grid.insert(&pts, Pose2::new(0.3 * f64::from(i), 0.0, 0.1)).unwrap();
+        grid.insert(&pts, Pose2::new(0.3 * f64::from(i), 0.0, 0.1))
+            .unwrap();
     }
     let mut keys: Vec<CellKey> = grid.keys().collect();
     keys.sort_unstable();
     grid.remove_cells(&keys[..keys.len() / 4]);
     for depth in 1..=4usize {
-        let levels: Vec<Level> = (0..=depth).map(|l| grid.level(l).unwrap().clone()).collect();
+        let levels: Vec<Level> = (0..=depth)
+            .map(|l| grid.level(l).unwrap().clone())
+            .collect();
         let shape = Shape::new(&levels).unwrap();
         // Every other ancestor of the shape level, plus one with no cell.
         let mut ancestors: rustc_hash::FxHashSet<CellKey> =
             shape.cells().keys().copied().step_by(2).collect();
-        ancestors.insert(CellKey { ix: 10_000, iy: 10_000 });
-        let mut got = shape.descendants(&ancestors);
+        ancestors.insert(CellKey {
+            ix: 10_000,
+            iy: 10_000,
+        });
+        let found = shape.descendants(&ancestors);
+        for (a, k, stats) in &found {
+            assert_eq!(ndt_core::pyramid::coarse_key(*k, depth), *a);
+            assert_eq!(grid.stats(*k), Some(*stats));
+        }
+        let mut got: Vec<CellKey> = found.iter().map(|f| f.1).collect();
         let n = got.len();
         got.sort_unstable();
         got.dedup();
