@@ -96,6 +96,8 @@ impl<'a> PairBlock<'a> {
 mod tests {
     use super::*;
     use nalgebra::Matrix2;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
 
     /// Most pairs one point adds (the 3 × 3 block of
     /// [`crate::matcher::MatchOptions::pair_neighbors`]).
@@ -105,13 +107,8 @@ mod tests {
     /// block boundaries, with several pairs per point and with weights.
     #[test]
     fn same_bits_as_point_by_point() {
-        let mut seed: u64 = 11;
-        let mut next = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
-        };
+        let mut rng = StdRng::seed_from_u64(11);
+        let mut next = move || rng.random_range(-0.5f64..0.5);
         let dists: Vec<Gaussian> = (0..40)
             .map(|_| {
                 let a = 400.0 + 300.0 * next();

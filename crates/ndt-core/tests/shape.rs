@@ -10,6 +10,8 @@ use ndt_core::distributions::{DistOptions, Distributions};
 use ndt_core::pyramid::Level;
 use ndt_core::shape::Shape;
 use ndt_core::{CellKey, MatchOptions, NdtGrid, Pose2};
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
 
 #[test]
 fn a_one_point_cell_on_a_wall_takes_the_walls_orientation_and_keeps_its_mean() {
@@ -108,13 +110,8 @@ fn shaped_distributions_stay_equal_to_a_fresh_build_under_inserts_and_removals()
 #[test]
 fn descendants_are_the_occupied_cells_under_the_ancestors() {
     let mut grid = NdtGrid::new(0.02).unwrap();
-    let mut seed: u64 = 9;
-    let mut next = move || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((seed >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
-    };
+    let mut rng = StdRng::seed_from_u64(9);
+    let mut next = move || rng.random_range(-0.5f64..0.5);
     for i in 0..6 {
         let pts: Vec<[f64; 2]> = (0..300).map(|_| [4.0 * next(), 4.0 * next()]).collect();
         grid.insert(&pts, Pose2::new(0.3 * f64::from(i), 0.0, 0.1))

@@ -275,6 +275,8 @@ fn walk_until(
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
 
     fn walk(from: [f64; 2], to: [f64; 2], cell: f64) -> Vec<(CellKey, f64, f64)> {
         let mut out = Vec::new();
@@ -431,13 +433,8 @@ mod tests {
     /// stops.
     #[test]
     fn skipping_empty_blocks_visits_the_other_cells_exactly() {
-        let mut seed: u64 = 5;
-        let mut next = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
-        };
+        let mut rng = StdRng::seed_from_u64(5);
+        let mut next = move || rng.random_range(-0.5f64..0.5);
         let cell = 0.02;
         let region =
             KeyBounds::of(CellKey { ix: -900, iy: -900 }).including(CellKey { ix: 900, iy: 900 });
