@@ -107,13 +107,10 @@ impl Distributions {
                     }
                 };
                 match shaped {
-                    Some(covariance) => {
-                        let centre = key.center(cell_size);
-                        match covariance.and_then(|c| Gaussian::from_shape(own, centre, &c)) {
-                            Some(g) => self.map.insert(key, g),
-                            None => self.map.remove(key),
-                        }
-                    }
+                    Some(covariance) => match in_shape(own, key.center(cell_size), &covariance) {
+                        Some(g) => self.map.insert(key, g),
+                        None => self.map.remove(key),
+                    },
                     None => self.recompute(cells, cell_size, shape, &mut shapes, key),
                 }
             }
@@ -234,6 +231,16 @@ fn shape_of_ancestor(s: Shape<'_>, at: CellKey, options: DistOptions) -> Option<
         .map(|region| Gaussian::shape_of(region, options.sigma_floor, options.expansion))
 }
 
+/// A cell's shaped distribution: its own mean, the ancestor's covariance
+/// part (`None`: the ancestor has no distribution, nor has the cell).
+fn in_shape(
+    own: &CellStats,
+    centre: Vector2<f64>,
+    covariance: &Option<Gaussian>,
+) -> Option<Gaussian> {
+    Gaussian::from_shape(own, centre, covariance.as_ref()?)
+}
+
 /// The distribution of one cell under `options`, from the sums alone.
 fn distribution_of(
     cells: &FxHashMap<CellKey, CellStats>,
@@ -253,7 +260,7 @@ fn distribution_of(
             .entry(at)
             .or_insert_with(|| shape_of_ancestor(s, at, options));
         if let Some(covariance) = shaped {
-            return Gaussian::from_shape(own, centre, covariance.as_ref()?);
+            return in_shape(own, centre, covariance);
         }
     }
     if own.count >= MIN_POINTS || !options.fuse_minority {

@@ -36,7 +36,8 @@ pub fn former_cell_short_of(
         hit - ray * (window / range)
     };
     let mut found = false;
-    let mut probe = grid.occupancy_probe();
+    // The walk crosses the blocks the pyramid shows empty without visiting
+    // them; the cells it visits are looked up.
     walk_cells_in_skipping(
         start,
         hit,
@@ -44,7 +45,7 @@ pub fn former_cell_short_of(
         grid.key_bounds(),
         &mut grid.occupancy_probe(),
         |key, _, _| {
-            if key != hit_key && probe.may_hold(key) && grid.stats(key).is_some() {
+            if key != hit_key && grid.stats(key).is_some() {
                 found = true;
             }
             !found

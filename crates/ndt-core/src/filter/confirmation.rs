@@ -103,7 +103,8 @@ pub fn passed_cells(
     let dir = ray / range;
     let reach = range - margin;
     let cell_size = grid.cell_size();
-    let mut probe = grid.occupancy_probe();
+    // The walk crosses the blocks the pyramid shows empty without visiting
+    // them; the cells it visits are looked up.
     walk_cells_in_skipping(
         sensor,
         sensor + dir * reach,
@@ -111,9 +112,6 @@ pub fn passed_cells(
         grid.key_bounds(),
         &mut grid.occupancy_probe(),
         |key, _, _| {
-            if !probe.may_hold(key) {
-                return true;
-            }
             let Some(stats) = grid.stats(key) else {
                 return true;
             };
