@@ -29,6 +29,7 @@ pub mod freespace;
 pub mod grid;
 pub mod information;
 pub mod key;
+pub mod lanexp;
 pub mod mapper;
 pub mod matcher;
 pub mod memo;

@@ -15,7 +15,7 @@ use crate::key::CellKey;
 use crate::memo::LevelMemo;
 use crate::neighbor::nearest_in_rings_with;
 use crate::reduce::voxel_runs;
-use crate::score::{Accumulator, Order, ScoreTerms};
+use crate::score::{Order, ScoreTerms};
 use crate::se2::Pose2;
 use crate::solver::{covariance_from_hessian, minimise, SolverOptions};
 use crate::table::Cursor;
@@ -360,16 +360,12 @@ fn evaluate_serial(
     order: Order,
 ) -> ScoreTerms {
     let sin_cos = pose.theta.sin_cos();
-    let scan = Scan {
-        points,
-        weights,
-        sin_cos,
-        order,
-    };
-    let mut terms = Accumulator::default();
+    let scan = Scan { sin_cos, order };
+    let mut matched = 0;
     let mut block = PairBlock::default();
     let mut cursor = dists.cursor();
     for (i, p) in points.iter().enumerate() {
+        let w = weights.and_then(|w| w.get(i)).copied().unwrap_or(1.0);
         let xw = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
         if options.pair_neighbors {
             let Some(key) = CellKey::of(xw, inv_cell) else {
@@ -379,23 +375,22 @@ fn evaluate_serial(
             for dy in -1..=1 {
                 for dx in -1..=1 {
                     if let Some(g) = cursor.get(key.offset(dx, dy)) {
-                        block.push(i, xw, g, &scan, &mut terms);
+                        block.push(*p, w, xw, g, &scan);
                         any = true;
                     }
                 }
             }
             if any {
-                terms.matched += 1;
+                matched += 1;
                 continue;
             }
         }
         if let Some(g) = pair(&mut cursor, xw, inv_cell, options) {
-            block.push(i, xw, g, &scan, &mut terms);
-            terms.matched += 1;
+            block.push(*p, w, xw, g, &scan);
+            matched += 1;
         }
     }
-    block.flush(&scan, &mut terms);
-    terms.finish()
+    block.finish(&scan, matched)
 }
 
 /// Score terms of (weighted) points at `pose` summed over the pyramid levels
