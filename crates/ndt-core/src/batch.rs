@@ -40,10 +40,32 @@ struct Chunk {
     c11: [f64; LANES],
     /// Scan points the pair stands for (0 for padding).
     w: [f64; LANES],
+    /// The distribution's surface normal ([`Gaussian::normal`]).
+    nx: [f64; LANES],
+    ny: [f64; LANES],
+    /// 1 when the distribution is the point's own cell's, else 0.
+    own: [f64; LANES],
 }
 
-/// Running sums per lane: `E`, `g₀…g₂`, `H₀₀ H₀₁ H₀₂ H₁₁ H₁₂ H₂₂`.
-type LaneSums = [[f64; LANES]; 10];
+/// Rows of [`LaneSums`].
+const SUMS: usize = 16;
+
+/// Running sums per lane: `E`, `g₀…g₂`, `H₀₀ H₀₁ H₀₂ H₁₁ H₁₂ H₂₂`, and the
+/// point-to-plane information of own-cell pairs `A₀₀ A₀₁ A₀₂ A₁₁ A₁₂ A₂₂`.
+type LaneSums = [[f64; LANES]; SUMS];
+
+/// What one pass over a scan's pairs gives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PassTerms {
+    /// Score, gradient and Hessian (eq. 1, 4, 5).
+    pub terms: ScoreTerms,
+    /// With [`Order::Derivatives`], the point-to-plane information
+    /// `Σ Jᵢᵀ nᵢ nᵢᵀ Jᵢ` of the points paired with their own cell's
+    /// distribution (what [`crate::information::point_to_plane_information`]
+    /// gives for [`crate::information::own_cell_pairs`]; each point counts
+    /// once, whatever its weight); zero with [`Order::Value`].
+    pub information: Matrix3<f64>,
+}
 
 /// One block of pairs waiting for their arithmetic, and the lane sums of
 /// the blocks before it.
@@ -58,7 +80,7 @@ impl Default for PairBlock {
         Self {
             chunks: [Chunk::default(); CHUNKS],
             len: 0,
-            sums: [[0.0; LANES]; 10],
+            sums: [[0.0; LANES]; SUMS],
         }
     }
 }
@@ -75,7 +97,8 @@ pub struct Scan {
 impl PairBlock {
     /// Queues scan point `x`, standing for `weight` points (1 for a point;
     /// see [`crate::reduce`]), mapped to `xw = R(θ) x + t` (eq. 2) and paired
-    /// with `dist`; runs the block first when it is full.
+    /// with `dist`, which is its own cell's when `own`; runs the block first
+    /// when it is full.
     #[inline]
     pub fn push(
         &mut self,
@@ -83,6 +106,7 @@ impl PairBlock {
         weight: f64,
         xw: Vector2<f64>,
         dist: &Gaussian,
+        own: bool,
         scan: &Scan,
     ) {
         if self.len == LANES * CHUNKS {
@@ -102,6 +126,9 @@ impl PairBlock {
         ch.c01[l] = m[(0, 1)];
         ch.c11[l] = m[(1, 1)];
         ch.w[l] = weight;
+        ch.nx[l] = dist.normal.x;
+        ch.ny[l] = dist.normal.y;
+        ch.own[l] = if own { 1.0 } else { 0.0 };
         self.len += 1;
     }
 
@@ -119,6 +146,9 @@ impl PairBlock {
                 last.c01[l] = 0.0;
                 last.c11[l] = 0.0;
                 last.w[l] = 0.0;
+                last.nx[l] = 0.0;
+                last.ny[l] = 0.0;
+                last.own[l] = 0.0;
             }
         }
         let chunks = self.chunks.get(..used).unwrap_or(&[]);
@@ -132,16 +162,21 @@ impl PairBlock {
     }
 
     /// The terms of every pair pushed, the lanes summed in order; `matched`
-    /// is the caller's count of points that had a distribution.
-    pub fn finish(mut self, scan: &Scan, matched: usize) -> ScoreTerms {
+    /// is the caller's count of points that had a distribution. Leaves the
+    /// block empty, as new.
+    pub fn finish(&mut self, scan: &Scan, matched: usize) -> PassTerms {
         self.flush(scan);
         let total = self.sums.map(|lanes| lanes.iter().fold(0.0, |a, v| a + v));
-        let [e, g0, g1, g2, h00, h01, h02, h11, h12, h22] = total;
-        ScoreTerms {
-            score: e,
-            gradient: Vector3::new(g0, g1, g2),
-            hessian: Matrix3::new(h00, h01, h02, h01, h11, h12, h02, h12, h22),
-            matched,
+        self.sums = [[0.0; LANES]; SUMS];
+        let [e, g0, g1, g2, h00, h01, h02, h11, h12, h22, a00, a01, a02, a11, a12, a22] = total;
+        PassTerms {
+            terms: ScoreTerms {
+                score: e,
+                gradient: Vector3::new(g0, g1, g2),
+                hessian: Matrix3::new(h00, h01, h02, h01, h11, h12, h02, h12, h22),
+                matched,
+            },
+            information: Matrix3::new(a00, a01, a02, a01, a11, a12, a02, a12, a22),
         }
     }
 }
@@ -208,6 +243,16 @@ fn add_chunks(chunks: &[Chunk], sin_cos: (f64, f64), derivatives: bool, sums: &m
             sums[7][l] += (c11[l] - u[1] * u[1]) * sl;
             sums[8][l] += (m12 - u[1] * u[2]) * sl;
             sums[9][l] += (m22 + second - u[2] * u[2]) * sl;
+            // Point-to-plane information (crate::information): Jᵀn of own-cell
+            // pairs, whatever their term.
+            let (nx, ny, o) = (ch.nx[l], ch.ny[l], ch.own[l]);
+            let j2 = nx * a + ny * b;
+            sums[10][l] += o * (nx * nx);
+            sums[11][l] += o * (nx * ny);
+            sums[12][l] += o * (nx * j2);
+            sums[13][l] += o * (ny * ny);
+            sums[14][l] += o * (ny * j2);
+            sums[15][l] += o * (j2 * j2);
         }
     }
 }
@@ -216,6 +261,7 @@ fn add_chunks(chunks: &[Chunk], sin_cos: (f64, f64), derivatives: bool, sums: &m
 mod tests {
     use super::*;
     use crate::score::Accumulator;
+    use crate::se2::Pose2;
     use nalgebra::Matrix2;
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
@@ -261,6 +307,7 @@ mod tests {
                 let mut magnitude = ScoreTerms::default();
                 let mut block = PairBlock::default();
                 let mut pairs = 0;
+                let mut own_pairs = Vec::new();
                 for (i, p) in points.iter().enumerate() {
                     let x = Vector2::new(p[0], p[1]);
                     let xw = Vector2::new(x.x + 0.01, x.y - 0.02);
@@ -275,13 +322,17 @@ mod tests {
                         magnitude.score += one.score.abs();
                         magnitude.gradient += one.gradient.abs();
                         magnitude.hessian += one.hessian.abs();
-                        block.push(*p, wi, xw, g, &scan);
+                        block.push(*p, wi, xw, g, j == 0, &scan);
+                        if j == 0 {
+                            own_pairs.push((x, g));
+                        }
                         pairs += 1;
                     }
                 }
                 assert!(pairs > LANES * CHUNKS * 3);
                 let (a, m) = (naive.finish(), magnitude);
-                let b = block.finish(&scan, a.matched);
+                let pass = block.finish(&scan, a.matched);
+                let b = pass.terms;
                 assert!(close(a.score, b.score, m.score), "{a:?} vs {b:?}");
                 for k in 0..3 {
                     assert!(close(a.gradient[k], b.gradient[k], m.gradient[k]));
@@ -295,8 +346,20 @@ mod tests {
                 }
                 if order == Order::Value {
                     assert_eq!(b.gradient, Vector3::zeros());
+                    assert_eq!(pass.information, Matrix3::zeros());
                 } else {
                     assert!(b.hessian[(2, 2)] != 0.0);
+                    // The information of the own-cell pairs only, unweighted.
+                    let want = crate::information::point_to_plane_information(
+                        own_pairs.iter().copied(),
+                        Pose2::new(0.0, 0.0, 0.3),
+                    );
+                    let scale = want.abs().max();
+                    assert!(
+                        (pass.information - want).abs().max() <= 1e-13 * scale,
+                        "{} vs {want}",
+                        pass.information
+                    );
                 }
             }
         }
@@ -331,16 +394,26 @@ mod tests {
             let xw = Vector2::new(p[0], p[1]);
             match i % 3 {
                 0 => {
-                    with_bad.push(*p, 1.0, xw, if i % 2 == 0 { &huge } else { &far }, &scan);
-                    with_zero.push(*p, 0.0, xw, &g, &scan);
+                    with_bad.push(
+                        *p,
+                        1.0,
+                        xw,
+                        if i % 2 == 0 { &huge } else { &far },
+                        true,
+                        &scan,
+                    );
+                    with_zero.push(*p, 0.0, xw, &g, true, &scan);
                 }
                 _ => {
-                    with_bad.push(*p, 1.0, xw, &g, &scan);
-                    with_zero.push(*p, 1.0, xw, &g, &scan);
+                    with_bad.push(*p, 1.0, xw, &g, true, &scan);
+                    with_zero.push(*p, 1.0, xw, &g, true, &scan);
                 }
             }
         }
-        let (a, b) = (with_bad.finish(&scan, 0), with_zero.finish(&scan, 0));
+        let (a, b) = (
+            with_bad.finish(&scan, 0).terms,
+            with_zero.finish(&scan, 0).terms,
+        );
         assert!(a.score > 0.0 && a.hessian.iter().all(|v| v.is_finite()));
         assert_eq!(a, b);
     }

@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector2};
 
-use crate::batch::{PairBlock, Scan};
+use crate::batch::{PairBlock, PassTerms, Scan};
 use crate::cell::{Gaussian, DEFAULT_SIGMA_FLOOR};
 use crate::degeneracy::{constrained_projector, unconstrained_directions};
 use crate::distributions::{DistOptions, Distributions};
@@ -298,20 +298,20 @@ pub struct MatchResult {
     pub unconstrained: Vec<[f64; 3]>,
 }
 
-/// The distribution a map-frame point is paired with: its own cell's, else
-/// (with neighbour search) the nearest one found ring by ring.
+/// The distribution a map-frame point is paired with: its own cell's
+/// (`true`), else (with neighbour search) the nearest one found ring by ring.
 #[inline]
 fn pair<'a>(
     cursor: &mut Cursor<'a, Gaussian>,
     xw: Vector2<f64>,
     inv_cell: f64,
     options: &MatchOptions,
-) -> Option<&'a Gaussian> {
+) -> Option<(&'a Gaussian, bool)> {
     let key = CellKey::of(xw, inv_cell)?;
     match cursor.get(key) {
-        Some(g) => Some(g),
+        Some(g) => Some((g, true)),
         None if options.neighbor_search => {
-            nearest_in_rings_with(cursor, xw, key, options.search_radius)
+            nearest_in_rings_with(cursor, xw, key, options.search_radius).map(|g| (g, false))
         }
         None => None,
     }
@@ -327,12 +327,12 @@ pub(crate) fn evaluate(
     inv_cell: f64,
     options: &MatchOptions,
     order: Order,
-) -> ScoreTerms {
+) -> PassTerms {
     if !options.parallel || points.len() < PARALLEL_MIN_POINTS {
         return evaluate_serial(dists, points, weights, pose, inv_cell, options, order);
     }
     use rayon::prelude::*;
-    let parts: Vec<ScoreTerms> = points
+    let parts: Vec<PassTerms> = points
         .par_chunks(PARALLEL_CHUNK)
         .enumerate()
         .map(|(i, chunk)| {
@@ -341,10 +341,14 @@ pub(crate) fn evaluate(
             evaluate_serial(dists, chunk, w, pose, inv_cell, options, order)
         })
         .collect();
-    let mut total = ScoreTerms::default();
+    let mut total = PassTerms {
+        terms: ScoreTerms::default(),
+        information: Matrix3::zeros(),
+    };
     for t in &parts {
-        total.add_terms(t);
-        total.matched += t.matched; // disjoint points
+        total.terms.add_terms(&t.terms);
+        total.terms.matched += t.terms.matched; // disjoint points
+        total.information += t.information;
     }
     total
 }
@@ -358,7 +362,7 @@ fn evaluate_serial(
     inv_cell: f64,
     options: &MatchOptions,
     order: Order,
-) -> ScoreTerms {
+) -> PassTerms {
     let sin_cos = pose.theta.sin_cos();
     let scan = Scan { sin_cos, order };
     let mut matched = 0;
@@ -375,7 +379,7 @@ fn evaluate_serial(
             for dy in -1..=1 {
                 for dx in -1..=1 {
                     if let Some(g) = cursor.get(key.offset(dx, dy)) {
-                        block.push(*p, w, xw, g, &scan);
+                        block.push(*p, w, xw, g, dx == 0 && dy == 0, &scan);
                         any = true;
                     }
                 }
@@ -385,8 +389,8 @@ fn evaluate_serial(
                 continue;
             }
         }
-        if let Some(g) = pair(&mut cursor, xw, inv_cell, options) {
-            block.push(*p, w, xw, g, &scan);
+        if let Some((g, own)) = pair(&mut cursor, xw, inv_cell, options) {
+            block.push(*p, w, xw, g, own, &scan);
             matched += 1;
         }
     }
@@ -424,8 +428,9 @@ fn stack_terms(
                 m.put(*level, pose, order, t);
             }
         }
-        total.add_terms(&t);
-        total.matched = total.matched.max(t.matched); // the same points on each level
+        total.add_terms(&t.terms);
+        // The same points on each level.
+        total.matched = total.matched.max(t.terms.matched);
     }
     total
 }
@@ -504,8 +509,11 @@ impl NdtGrid {
             // Not on the first stage: its start may be far off, and pairs
             // found there would misjudge the geometry.
             if options.freeze_unconstrained && level + 1 < levels {
-                if let Some((_, d)) = stack.first() {
-                    let info = point_to_plane_information(own_cell_pairs(d, points, pose), pose);
+                if let Some((coarse, d)) = stack.first() {
+                    // Usually computed where the stage before ended.
+                    let info = memo.information(*coarse, pose).unwrap_or_else(|| {
+                        point_to_plane_information(own_cell_pairs(d, points, pose), pose)
+                    });
                     solver.projector = constrained_projector(&info, lever, options.freeze_ratio);
                 }
             }
@@ -572,8 +580,10 @@ impl NdtGrid {
             });
         };
         let hessian = outcome.terms.hessian;
-        let information = stack.first().map_or_else(Matrix3::zeros, |(_, d)| {
-            point_to_plane_information(own_cell_pairs(d, points, pose), pose)
+        let information = stack.first().map_or_else(Matrix3::zeros, |(level, d)| {
+            memo.information(*level, pose).unwrap_or_else(|| {
+                point_to_plane_information(own_cell_pairs(d, points, pose), pose)
+            })
         });
         Ok(MatchResult {
             pose: outcome.pose,
@@ -658,6 +668,7 @@ impl NdtGrid {
             self.inv_cell_size(),
             options,
             order,
-        ))
+        )
+        .terms)
     }
 }

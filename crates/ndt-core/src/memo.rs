@@ -7,7 +7,10 @@
 //! stage computed last. Reusing them saves one pass over the scan per stage,
 //! and changes no bit (the same sums, taken from where they were computed).
 
-use crate::score::{Order, ScoreTerms};
+use nalgebra::Matrix3;
+
+use crate::batch::PassTerms;
+use crate::score::Order;
 use crate::se2::Pose2;
 
 /// Entries kept: a stage's last few evaluations (its final pose need not be
@@ -17,14 +20,14 @@ const CAPACITY: usize = 8;
 /// The last few (8) evaluations of whole-scan score terms, by level.
 #[derive(Debug, Default)]
 pub struct LevelMemo {
-    entries: Vec<(usize, Pose2, Order, ScoreTerms)>,
+    entries: Vec<(usize, Pose2, Order, PassTerms)>,
     next: usize,
 }
 
 impl LevelMemo {
     /// The terms of `level` at exactly `pose`, if computed with at least
     /// `order` (derivatives include the value).
-    pub fn get(&self, level: usize, pose: Pose2, order: Order) -> Option<ScoreTerms> {
+    pub fn get(&self, level: usize, pose: Pose2, order: Order) -> Option<PassTerms> {
         self.entries
             .iter()
             .find(|(l, p, o, _)| {
@@ -33,8 +36,17 @@ impl LevelMemo {
             .map(|e| e.3)
     }
 
+    /// The point-to-plane information of `level`'s own-cell pairs at exactly
+    /// `pose` ([`PassTerms::information`]), if a pass with derivatives
+    /// computed it there. A stage's frozen directions are those of its
+    /// coarser level at its start, where the stage before ended.
+    pub fn information(&self, level: usize, pose: Pose2) -> Option<Matrix3<f64>> {
+        self.get(level, pose, Order::Derivatives)
+            .map(|t| t.information)
+    }
+
     /// Records the terms of `level` at `pose`.
-    pub fn put(&mut self, level: usize, pose: Pose2, order: Order, terms: ScoreTerms) {
+    pub fn put(&mut self, level: usize, pose: Pose2, order: Order, terms: PassTerms) {
         let entry = (level, pose, order, terms);
         if self.entries.len() < CAPACITY {
             self.entries.push(entry);
@@ -49,10 +61,15 @@ impl LevelMemo {
 mod tests {
     use super::*;
 
-    fn terms(score: f64) -> ScoreTerms {
-        ScoreTerms {
-            score,
-            ..ScoreTerms::default()
+    use crate::score::ScoreTerms;
+
+    fn terms(score: f64) -> PassTerms {
+        PassTerms {
+            terms: ScoreTerms {
+                score,
+                ..ScoreTerms::default()
+            },
+            information: Matrix3::identity() * score,
         }
     }
 
@@ -61,7 +78,9 @@ mod tests {
         let mut m = LevelMemo::default();
         let p = Pose2::new(0.1, 0.2, 0.3);
         m.put(2, p, Order::Value, terms(1.0));
-        assert_eq!(m.get(2, p, Order::Value).map(|t| t.score), Some(1.0));
+        assert_eq!(m.get(2, p, Order::Value).map(|t| t.terms.score), Some(1.0));
+        // Information comes from passes with derivatives only.
+        assert!(m.information(2, p).is_none());
         // Value terms cannot stand in for derivatives.
         assert!(m.get(2, p, Order::Derivatives).is_none());
         assert!(m.get(1, p, Order::Value).is_none());
@@ -69,7 +88,11 @@ mod tests {
             .get(2, Pose2::new(0.1, 0.2, 0.3 + 1e-15), Order::Value)
             .is_none());
         m.put(2, p, Order::Derivatives, terms(2.0));
-        assert_eq!(m.get(2, p, Order::Derivatives).map(|t| t.score), Some(2.0));
+        assert_eq!(
+            m.get(2, p, Order::Derivatives).map(|t| t.terms.score),
+            Some(2.0)
+        );
+        assert_eq!(m.information(2, p), Some(Matrix3::identity() * 2.0));
     }
 
     #[test]
@@ -86,7 +109,10 @@ mod tests {
         assert!(m.get(0, Pose2::new(0.0, 0.0, 0.0), Order::Value).is_none());
         for i in 1..=CAPACITY {
             let p = Pose2::new(i as f64, 0.0, 0.0);
-            assert_eq!(m.get(0, p, Order::Value).map(|t| t.score), Some(i as f64));
+            assert_eq!(
+                m.get(0, p, Order::Value).map(|t| t.terms.score),
+                Some(i as f64)
+            );
         }
     }
 }

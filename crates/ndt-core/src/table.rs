@@ -23,6 +23,13 @@ const EMPTY: u32 = u32::MAX;
 
 type Tile = [u32; (TILE * TILE) as usize];
 
+/// A value starting on a cache line: a [`crate::cell::Gaussian`] is 64 bytes,
+/// so each one takes exactly one line and a look-up touches one line, not
+/// two (with the key beside it, three in four values straddled a boundary).
+#[derive(Debug, Clone, Copy)]
+#[repr(align(64))]
+struct Line<T>(T);
+
 /// Tile index and slot within the tile of `key`.
 #[inline]
 fn split(key: CellKey) -> ((i32, i32), usize) {
@@ -55,7 +62,9 @@ pub struct CellTable<T> {
     /// Occupied tile slots per tile, so empty tiles can be reused.
     used: Vec<u32>,
     free_tiles: Vec<u32>,
-    values: Vec<(CellKey, T)>,
+    /// The values, contiguous, and beside them (same index) their keys.
+    values: Vec<Line<T>>,
+    keys: Vec<CellKey>,
     /// The tile of the last insert (runs of inserts in one tile skip the hash).
     last_insert: Option<((i32, i32), u32)>,
 }
@@ -67,6 +76,8 @@ impl<T: Clone> Clone for CellTable<T> {
     fn clone(&self) -> Self {
         let mut values = Vec::with_capacity(self.values.capacity());
         values.extend_from_slice(&self.values);
+        let mut keys = Vec::with_capacity(self.keys.capacity());
+        keys.extend_from_slice(&self.keys);
         let mut slots = Vec::with_capacity(self.slots.capacity());
         slots.extend_from_slice(&self.slots);
         Self {
@@ -75,6 +86,7 @@ impl<T: Clone> Clone for CellTable<T> {
             used: self.used.clone(),
             free_tiles: self.free_tiles.clone(),
             values,
+            keys,
             last_insert: self.last_insert,
         }
     }
@@ -88,6 +100,7 @@ impl<T> Default for CellTable<T> {
             used: Vec::new(),
             free_tiles: Vec::new(),
             values: Vec::new(),
+            keys: Vec::new(),
             last_insert: None,
         }
     }
@@ -98,6 +111,7 @@ impl<T> CellTable<T> {
     pub fn with_capacity(cells: usize) -> Self {
         let mut t = Self::default();
         t.values.reserve(cells);
+        t.keys.reserve(cells);
         t
     }
 
@@ -125,7 +139,7 @@ impl<T> CellTable<T> {
         if i == EMPTY {
             None
         } else {
-            Some(&self.values[i as usize].1)
+            Some(&self.values[i as usize].0)
         }
     }
 
@@ -152,10 +166,11 @@ impl<T> CellTable<T> {
         let i = &mut self.slots[t as usize][slot];
         if *i == EMPTY {
             *i = self.values.len() as u32;
-            self.values.push((key, value));
+            self.values.push(Line(value));
+            self.keys.push(key);
             self.used[t as usize] += 1;
         } else {
-            self.values[*i as usize].1 = value;
+            self.values[*i as usize] = Line(value);
         }
     }
 
@@ -178,7 +193,8 @@ impl<T> CellTable<T> {
         }
         // Keep the values contiguous: move the last one into the hole.
         self.values.swap_remove(i as usize);
-        if let Some(&(moved, _)) = self.values.get(i as usize) {
+        self.keys.swap_remove(i as usize);
+        if let Some(&moved) = self.keys.get(i as usize) {
             let (mt, ms) = split(moved);
             if let Some(&mt) = self.tiles.get(&mt) {
                 self.slots[mt as usize][ms] = i;
@@ -188,13 +204,14 @@ impl<T> CellTable<T> {
 
     /// Every `(key, value)`, in no particular order.
     pub fn iter(&self) -> impl Iterator<Item = (CellKey, &T)> {
-        self.values.iter().map(|(k, v)| (*k, v))
+        self.keys.iter().zip(&self.values).map(|(k, v)| (*k, &v.0))
     }
 
     /// Bytes this table holds on the heap (capacity, not length): the values,
     /// the tiles and the tile index.
     pub fn heap_bytes(&self) -> usize {
-        self.values.capacity() * std::mem::size_of::<(CellKey, T)>()
+        self.values.capacity() * std::mem::size_of::<Line<T>>()
+            + self.keys.capacity() * std::mem::size_of::<CellKey>()
             + self.slots.capacity() * std::mem::size_of::<Tile>()
             + self.used.capacity() * 4
             + self.free_tiles.capacity() * 4
