@@ -82,14 +82,15 @@ def se2_apply(pose: np.ndarray, pts: np.ndarray) -> np.ndarray:
     return pts @ np.array([[c, s], [-s, c]]) + pose[:2]
 
 
-def test_synthetic_scan_recovered_to_a_millimetre() -> None:
+@pytest.mark.parametrize("coarse_model", [True, False])
+def test_synthetic_scan_recovered_to_a_millimetre(coarse_model: bool) -> None:
     grid = room_map()
     truth = np.array([0.12, -0.08, 0.2])
     pts = scan(truth, seed=99)
     rng = np.random.default_rng(5)
     for _ in range(10):
         guess = truth + np.r_[rng.uniform(-0.04, 0.04, 2), np.radians(rng.uniform(-1, 1))]
-        res = grid.match(pts, guess)
+        res = grid.match(pts, guess, coarse_model=coarse_model)
         assert res.converged
         err = se2.between(truth, res.pose)
         assert np.hypot(err[0], err[1]) < 1e-3

@@ -164,6 +164,7 @@ class NdtGrid:
         freeze_unconstrained: bool = True,
         freeze_ratio: float = 0.1,
         levels: int | None = None,
+        coarse_model: bool = True,
         expansion_phases: Sequence[float] | None = None,
         parallel: bool = False,
     ) -> MatchResult:
@@ -256,6 +257,15 @@ class NdtGrid:
             (from ``levels - 1`` down to 0) starts from the previous stage's
             pose and maximises the summed score of its level and the next
             coarser one, so the last stage includes the fine cells.
+        coarse_model : bool, default True
+            From the second stage on, score the coarser level of the stage by
+            its second-order expansion about the stage's start (the same
+            expansion a Newton step makes) instead of every point at every
+            trial pose; the returned score and Hessian are computed exactly at
+            the final pose. About 40 % fewer passes over the scan (median match
+            0.22 against 0.31 ms on the real SICK pairs of
+            ``benches/convergence.py``, 6189 against 6204 successes of 7680);
+            ``False`` scores every level exactly.
         expansion_phases : sequence of float, optional
             The phased adjustment of the authors' earlier paper (ICRA 2008):
             solve with each ``k`` in turn (e.g. ``[100, 10, 1]``), each from the
@@ -974,6 +984,7 @@ class OdometryLoop:
         coarse_rotation_search: float | None = None,
         freeze_unconstrained: bool | None = None,
         freeze_ratio: float | None = None,
+        coarse_model: bool | None = None,
         outlier_filter: bool | None = None,
         edge_removal: bool | None = None,
         backshift_rejection: bool | None = None,

@@ -101,6 +101,9 @@ class OdometryConfig:
         A direction is frozen when its curvature is below this fraction of the strongest
         (``NdtGrid.match`` uses 0.1 between two scans; against the loop's map of many
         scans 0.1 raised the relation error on three of the five benchmark logs).
+    coarse_model : bool, default True
+        Score the coarser pyramid level of each coarse-to-fine stage by its quadratic
+        model (``NdtGrid.match(coarse_model=...)``); ``False`` scores it exactly.
     outlier_filter : bool, default True
         Insert scans through the paper's §V elimination (sub-grid objects, wall
         speckle, moved objects) with :class:`~ndtgrid.MapperOptions`' defaults;
@@ -142,6 +145,7 @@ class OdometryConfig:
     coarse_rotation_search: float = 0.15
     freeze_unconstrained: bool = True
     freeze_ratio: float = 0.02
+    coarse_model: bool = True
     outlier_filter: bool = True
     edge_removal: bool = True
     backshift_rejection: bool = False

@@ -37,6 +37,7 @@ pub mod neighbor;
 pub mod odometry;
 pub mod persist;
 pub mod pyramid;
+pub mod quadratic;
 pub mod ranges;
 pub mod reduce;
 pub mod score;

@@ -14,6 +14,7 @@ use crate::information::{own_cell_pairs, point_to_plane_information};
 use crate::key::CellKey;
 use crate::memo::LevelMemo;
 use crate::neighbor::nearest_in_rings_with;
+use crate::quadratic::QuadraticModel;
 use crate::reduce::voxel_runs;
 use crate::score::{Order, ScoreTerms};
 use crate::se2::Pose2;
@@ -127,11 +128,22 @@ pub struct MatchOptions {
     /// the paper's method). Level `l` has cells `2^l` times the fine size.
     /// Stage `l` (from `levels − 1` down to 0) starts from the previous
     /// stage's pose and minimises `−(E_l + E_{l+1})`: its level's score plus
-    /// the next coarser one's (see [`LEVEL_WINDOW`]), so the final stage
-    /// includes the fine cells. `None`: as many of the grid's levels as keep
+    /// the next coarser one's (see [`LEVEL_WINDOW`]; the coarser one as its
+    /// quadratic model with [`MatchOptions::coarse_model`]), so the final
+    /// stage includes the fine cells. `None`: as many of the grid's levels as keep
     /// the coarsest cell at most [`AUTO_COARSEST_CELL`] (with 2 cm cells: 6
     /// levels, 2–64 cm; with 20 cm cells: 2 levels).
     pub levels: Option<u32>,
+    /// From the second coarse-to-fine stage on, score the coarser level of
+    /// the stage's window by its second-order expansion about the stage's
+    /// start ([`crate::quadratic`]) instead of every point at every trial
+    /// pose; the final pose's score and Hessian are then computed exactly.
+    /// About 40 % fewer passes over the scan. Measured with
+    /// `benches/convergence.py` (8 × 960 real SICK pairs, 8 starts each):
+    /// 6189 / 6054 successes from local / wide starts against 6204 / 6063
+    /// with every level scored exactly (`false`), median time 0.22 / 0.27
+    /// against 0.31 / 0.38 ms; `false` is the method before the model.
+    pub coarse_model: bool,
     /// Score scans of at least [`PARALLEL_MIN_POINTS`] points on all cores
     /// (rayon's global pool: `RAYON_NUM_THREADS` limits it), in fixed chunks
     /// of [`PARALLEL_CHUNK`] points summed in order, so the result does not
@@ -170,6 +182,7 @@ impl Default for MatchOptions {
             freeze_unconstrained: true,
             freeze_ratio: crate::degeneracy::FREEZE_RATIO,
             levels: None,
+            coarse_model: true,
             parallel: false,
         }
     }
@@ -517,8 +530,41 @@ impl NdtGrid {
                     solver.projector = constrained_projector(&info, lever, options.freeze_ratio);
                 }
             }
-            let mut objective = |p: Pose2, order: Order| {
-                stack_terms(&stack, points, None, p, options, order, Some(&mut memo))
+            // From the second stage on, the coarser level of the window is
+            // its quadratic model about the stage's start (crate::quadratic).
+            let model = match stack.as_slice() {
+                [(coarse, d), _] if options.coarse_model => {
+                    let terms = stack_terms(
+                        &[(*coarse, Arc::clone(d))],
+                        points,
+                        None,
+                        pose,
+                        options,
+                        Order::Derivatives,
+                        Some(&mut memo),
+                    );
+                    Some(QuadraticModel::new(pose, &terms))
+                }
+                _ => None,
+            };
+            let own = stack.len() - 1;
+            let mut objective = |p: Pose2, order: Order| match &model {
+                Some(m) => {
+                    let mut t = stack_terms(
+                        &stack[own..],
+                        points,
+                        None,
+                        p,
+                        options,
+                        order,
+                        Some(&mut memo),
+                    );
+                    let coarse = m.terms(p);
+                    t.add_terms(&coarse);
+                    t.matched = t.matched.max(coarse.matched);
+                    t
+                }
+                None => stack_terms(&stack, points, None, p, options, order, Some(&mut memo)),
             };
             let mut solved = minimise(pose, &solver, &mut objective);
             // The first (coarsest) stage also starts from the guess rotated
@@ -570,6 +616,18 @@ impl NdtGrid {
             }
             iterations += solved.iterations;
             pose = solved.pose;
+            if model.is_some() && level == 0 {
+                // The final score and Hessian exactly, both levels scored.
+                solved.terms = stack_terms(
+                    &stack,
+                    points,
+                    None,
+                    pose,
+                    options,
+                    Order::Derivatives,
+                    Some(&mut memo),
+                );
+            }
             outcome = Some(solved);
         }
         let Some(outcome) = outcome else {

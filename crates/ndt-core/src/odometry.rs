@@ -427,20 +427,24 @@ impl Odometry {
     pub fn update_map(&mut self, ranges: &[f64], angles: &[f64], pose: Pose2) -> Result<()> {
         let points = self.valid_points(ranges, angles)?;
         check_finite("pose", &pose.to_array())?;
-        // The cells this scan can touch (the filter stores a subset of them).
-        let inv = 1.0 / self.config.cell_size;
-        let mut seen = rustc_hash::FxHashSet::default();
-        let touched: Vec<CellKey> = points
-            .iter()
-            .filter_map(|p| CellKey::of(pose.transform(nalgebra::Vector2::new(p[0], p[1])), inv))
-            .filter(|k| seen.insert(*k))
-            .collect();
         // The mapper validates first (beams, pose, cell indices); the matching
         // grid's insert then cannot fail for the same points, pose and cells.
         self.mapper.insert_scan(ranges, angles, pose)?;
-        if !self.config.match_filtered_map {
-            self.grid.insert(&points, pose)?;
-        }
+        // The cells this scan touched (the filter stores a subset of them),
+        // each once: the matching grid's insert lists them.
+        let touched = if self.config.match_filtered_map {
+            let inv = 1.0 / self.config.cell_size;
+            let mut seen = rustc_hash::FxHashSet::default();
+            points
+                .iter()
+                .filter_map(|p| {
+                    CellKey::of(pose.transform(nalgebra::Vector2::new(p[0], p[1])), inv)
+                })
+                .filter(|k| seen.insert(*k))
+                .collect()
+        } else {
+            self.grid.insert(&points, pose)?
+        };
         self.record_insertion(touched, pose);
         Ok(())
     }

@@ -248,7 +248,7 @@ proptest! {
         search_radius in prop_oneof![0..4u32, Just(1000u32), Just(1001u32)].boxed(),
         max_iterations in prop_oneof![0..60u32, Just(200u32)].boxed(),
         levels in prop_oneof![Just(None), (0..9u32).prop_map(Some)].boxed(),
-        flags in any::<[bool; 5]>(),
+        flags in any::<[bool; 6]>(),
     ) {
         let grid = room_grid();
         let options = MatchOptions {
@@ -268,6 +268,7 @@ proptest! {
             freeze_unconstrained: flags[3],
             freeze_ratio,
             levels,
+            coarse_model: flags[5],
             parallel: flags[4],
         };
         match grid.match_scan(&pts, guess, &options) {
@@ -418,6 +419,7 @@ fn a_subnormal_expansion_gives_a_finite_score() {
         freeze_unconstrained: false,
         freeze_ratio: 0.1,
         levels: None,
+        coarse_model: true,
         parallel: false,
     };
     let pts = [[-2.3763401613489026, 2.3516387683799254]];

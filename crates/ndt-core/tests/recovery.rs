@@ -56,6 +56,47 @@ fn recovers_synthetic_scan_on_2cm_grid() {
 }
 
 #[test]
+fn recovers_synthetic_scan_on_2cm_grid_with_every_level_scored_exactly() {
+    let exact = MatchOptions {
+        coarse_model: false,
+        ..MatchOptions::default()
+    };
+    recover(0.02, 0.05, 1.5, 1, &exact);
+}
+
+/// With the coarser level modelled (the default), the result's score and
+/// Hessian are still the exact ones of both levels at the returned pose: the
+/// same as a match with every level scored exactly that starts there and
+/// stops at once.
+#[test]
+fn the_coarse_model_reports_the_exact_score_at_its_pose() {
+    let walls = common::room();
+    let grid = dense_map(0.02);
+    let truth = Pose2::new(0.12, -0.08, 0.2);
+    let scan = common::urg_scan(&walls, truth, 0.0, 99);
+    let guess = Pose2::new(0.15, -0.05, 0.21);
+    let res = grid.match_scan(&scan, guess, &MatchOptions::default()).unwrap();
+    let check = MatchOptions {
+        coarse_model: false,
+        levels: Some(2),
+        rotation_search: 0.0,
+        max_iterations: 0,
+        ..MatchOptions::default()
+    };
+    // Two levels, no iteration: the second stage scores levels 0 and 1
+    // exactly at the start.
+    let at = grid.match_scan(&scan, res.pose, &check).unwrap();
+    assert_eq!(at.pose, res.pose);
+    assert!(
+        (at.score - res.score).abs() <= 1e-12 * res.score.abs(),
+        "{} vs {}",
+        at.score,
+        res.score
+    );
+    assert!((at.hessian - res.hessian).abs().max() <= 1e-12 * res.hessian.abs().max());
+}
+
+#[test]
 fn recovers_synthetic_scan_on_20cm_grid() {
     // On a coarse grid the default's final stage also sums the 40 cm level,
     // whose expanded cells bias the optimum by ~2 mm: match on the 20 cm level.

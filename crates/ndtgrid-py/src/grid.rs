@@ -124,6 +124,7 @@ impl PyNdtGrid {
         pair_neighbors = false, search_radius = 1, max_iterations = 50, translation_tolerance = 1e-4,
         rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, rotation_search = 0.15, freeze_unconstrained = true, freeze_ratio = 0.1,
         levels = None,
+        coarse_model = true,
         expansion_phases = None,
         parallel = false
     ))]
@@ -149,6 +150,7 @@ impl PyNdtGrid {
         freeze_unconstrained: bool,
         freeze_ratio: f64,
         levels: Option<i64>,
+        coarse_model: bool,
         expansion_phases: Option<Vec<f64>>,
         parallel: bool,
     ) -> PyResult<PyMatchResult> {
@@ -169,6 +171,7 @@ impl PyNdtGrid {
             freeze_unconstrained,
             freeze_ratio,
             levels: levels.map(|l| count("levels", l)).transpose()?,
+            coarse_model,
             parallel,
         };
         let pts = points_arg(points)?;
@@ -368,6 +371,7 @@ fn options_dict<'py>(py: Python<'py>, d: &MatchOptions) -> PyResult<Bound<'py, P
     out.set_item("freeze_unconstrained", d.freeze_unconstrained)?;
     out.set_item("freeze_ratio", d.freeze_ratio)?;
     out.set_item("levels", d.levels)?;
+    out.set_item("coarse_model", d.coarse_model)?;
     out.set_item("expansion_phases", py.None())?;
     out.set_item("parallel", d.parallel)?;
     Ok(out)

@@ -108,7 +108,7 @@ impl PyOdometry {
         expansion = None, sigma_floor = None, shape_cell = None,
         neighbor_search = None, fuse_minority = None, search_radius = None,
         max_iterations = None, max_step_cells = None, max_step_rotation = None,
-        levels = None, coarse_rotation_search = None, freeze_unconstrained = None, freeze_ratio = None,
+        levels = None, coarse_rotation_search = None, freeze_unconstrained = None, freeze_ratio = None, coarse_model = None,
         outlier_filter = None, edge_removal = None, backshift_rejection = None,
         observation_check = None, radial_confirmation = None, match_filtered_map = None
     ))]
@@ -138,6 +138,7 @@ impl PyOdometry {
         coarse_rotation_search: Option<f64>,
         freeze_unconstrained: Option<bool>,
         freeze_ratio: Option<f64>,
+        coarse_model: Option<bool>,
         outlier_filter: Option<bool>,
         edge_removal: Option<bool>,
         backshift_rejection: Option<bool>,
@@ -174,6 +175,7 @@ impl PyOdometry {
             rotation_search: coarse_rotation_search.unwrap_or(m.rotation_search),
             freeze_unconstrained: freeze_unconstrained.unwrap_or(m.freeze_unconstrained),
             freeze_ratio: freeze_ratio.unwrap_or(m.freeze_ratio),
+            coarse_model: coarse_model.unwrap_or(m.coarse_model),
             ..m
         };
         let config = OdometryConfig {
@@ -294,6 +296,7 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("coarse_rotation_search", c.matcher.rotation_search)?;
     out.set_item("freeze_unconstrained", c.matcher.freeze_unconstrained)?;
     out.set_item("freeze_ratio", c.matcher.freeze_ratio)?;
+    out.set_item("coarse_model", c.matcher.coarse_model)?;
     out.set_item("outlier_filter", c.mapper.outlier_filter)?;
     out.set_item("edge_removal", c.mapper.edge_removal)?;
     out.set_item("backshift_rejection", c.mapper.backshift_rejection)?;
