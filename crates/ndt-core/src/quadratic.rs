@@ -48,6 +48,16 @@ impl QuadraticModel {
                 matched: terms.matched,
             };
         }
+        // Positive definite (the usual case at the end of a stage): |H| = H.
+        if terms.hessian.cholesky().is_some() {
+            return Self {
+                at,
+                score: terms.score,
+                gradient: terms.gradient,
+                hessian: terms.hessian,
+                matched: terms.matched,
+            };
+        }
         let eig = SymmetricEigen::new(terms.hessian);
         let absolute = eig.eigenvectors
             * Matrix3::from_diagonal(&eig.eigenvalues.map(f64::abs))

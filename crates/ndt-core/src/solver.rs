@@ -73,7 +73,16 @@ pub struct SolverOutcome {
 }
 
 /// `x ↦ V diag(1 / max(|λ|, floor)) Vᵀ x`: the inverse of the "absolute" Hessian.
+///
+/// Near an optimum `H` is positive definite with every eigenvalue above the
+/// floor; then `|H| = H` and the step is `H⁻¹ x` by Cholesky, without the
+/// iterative eigen-decomposition (the same step up to round-off). The test:
+/// `λ_min ≥ 1 / tr(H⁻¹)` and `λ_max ≤ tr(H)`, so `tr(H⁻¹)·tr(H) < 1 / floor`
+/// guarantees that the floor is not reached.
 fn solve_absolute(h: &Matrix3<f64>, rhs: &Vector3<f64>) -> Vector3<f64> {
+    if let Some(step) = solve_well_conditioned(h, rhs) {
+        return step;
+    }
     let eig = SymmetricEigen::new(*h);
     let scale = eig.eigenvalues.iter().fold(0.0_f64, |m, l| m.max(l.abs()));
     let floor = (EIGEN_FLOOR * scale).max(f64::MIN_POSITIVE);
@@ -85,6 +94,19 @@ fn solve_absolute(h: &Matrix3<f64>, rhs: &Vector3<f64>) -> Vector3<f64> {
         out += col * (col.dot(rhs) / lam);
     }
     out
+}
+
+/// `H⁻¹ x` when `H` is positive definite and `λ_max / λ_min` is certainly
+/// below `1 / EIGEN_FLOOR` (see [`solve_absolute`]); `None` otherwise.
+fn solve_well_conditioned(h: &Matrix3<f64>, rhs: &Vector3<f64>) -> Option<Vector3<f64>> {
+    let chol = h.cholesky()?;
+    let inverse = chol.inverse();
+    let (trace, trace_inverse) = (h.trace(), inverse.trace());
+    if !(trace > 0.0 && trace_inverse > 0.0 && trace * trace_inverse < 1.0 / EIGEN_FLOOR) {
+        return None;
+    }
+    let step = chol.solve(rhs);
+    step.iter().all(|v| v.is_finite()).then_some(step)
 }
 
 /// Pose covariance estimate `H⁻¹` of `−E` at the optimum (Laplace
@@ -194,5 +216,86 @@ where
         converged,
         iterations,
         terms,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    /// The eigen-decomposition path alone (what `solve_absolute` did for
+    /// every matrix before the Cholesky shortcut).
+    fn by_eigen(h: &Matrix3<f64>, rhs: &Vector3<f64>) -> Vector3<f64> {
+        let eig = SymmetricEigen::new(*h);
+        let scale = eig.eigenvalues.iter().fold(0.0_f64, |m, l| m.max(l.abs()));
+        let floor = (EIGEN_FLOOR * scale).max(f64::MIN_POSITIVE);
+        let v = &eig.eigenvectors;
+        (0..3)
+            .map(|i| {
+                let col = v.column(i);
+                col * (col.dot(rhs) / eig.eigenvalues[i].abs().max(floor))
+            })
+            .sum()
+    }
+
+    fn random_symmetric(rng: &mut StdRng, eigenvalues: [f64; 3]) -> Matrix3<f64> {
+        let q = nalgebra::Rotation3::from_euler_angles(
+            rng.random_range(-3.0..3.0),
+            rng.random_range(-1.5..1.5),
+            rng.random_range(-3.0..3.0),
+        );
+        let m = q.matrix()
+            * Matrix3::from_diagonal(&Vector3::from(eigenvalues))
+            * q.matrix().transpose();
+        (m + m.transpose()) * 0.5
+    }
+
+    #[test]
+    fn cholesky_shortcut_gives_the_eigen_step() {
+        let mut rng = StdRng::seed_from_u64(11);
+        let mut shortcuts = 0;
+        for i in 0..20_000 {
+            let scale = 10f64.powi(i % 7 - 3);
+            let mut l = [0.0; 3];
+            for v in &mut l {
+                // Mostly positive definite, some indefinite, some nearly
+                // singular (below and above the floor).
+                *v = scale
+                    * match i % 5 {
+                        0 => rng.random_range(-1.0..1.0),
+                        1 => 10f64.powf(rng.random_range(-12.0..0.0)),
+                        _ => rng.random_range(0.01..1.0),
+                    };
+            }
+            let h = random_symmetric(&mut rng, l);
+            let rhs = Vector3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            );
+            let want = by_eigen(&h, &rhs);
+            let got = solve_absolute(&h, &rhs);
+            if solve_well_conditioned(&h, &rhs).is_some() {
+                shortcuts += 1;
+            }
+            assert!(
+                (got - want).norm() <= 1e-6 * want.norm(),
+                "{h} {rhs}: {got} vs {want}"
+            );
+        }
+        assert!(shortcuts > 8_000, "{shortcuts}");
+    }
+
+    #[test]
+    fn shortcut_declines_below_the_floor_and_when_indefinite() {
+        let h = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 1e-10));
+        assert!(solve_well_conditioned(&h, &Vector3::new(1.0, 1.0, 1.0)).is_none());
+        let h = Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, 1.0));
+        assert!(solve_well_conditioned(&h, &Vector3::new(1.0, 1.0, 1.0)).is_none());
+        let h = Matrix3::from_diagonal(&Vector3::new(2.0, 1.0, 4.0));
+        let step = solve_well_conditioned(&h, &Vector3::new(2.0, 1.0, 4.0));
+        assert!(step.is_some_and(|s| (s - Vector3::new(1.0, 1.0, 1.0)).norm() < 1e-15));
     }
 }

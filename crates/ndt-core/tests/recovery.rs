@@ -75,7 +75,9 @@ fn the_coarse_model_reports_the_exact_score_at_its_pose() {
     let truth = Pose2::new(0.12, -0.08, 0.2);
     let scan = common::urg_scan(&walls, truth, 0.0, 99);
     let guess = Pose2::new(0.15, -0.05, 0.21);
-    let res = grid.match_scan(&scan, guess, &MatchOptions::default()).unwrap();
+    let res = grid
+        .match_scan(&scan, guess, &MatchOptions::default())
+        .unwrap();
     let check = MatchOptions {
         coarse_model: false,
         levels: Some(2),
