@@ -279,9 +279,11 @@ def main() -> int:
         print(f"  raw odometry: {e_raw}\n  ndtgrid:      {e_ours}", file=sys.stderr)
         if e_peer is not None:
             print(f"  small_gicp:   {e_peer}", file=sys.stderr)
+        span = "unknown (broken timestamps)" if math.isnan(duration) else f"~{duration:.0f} s"
+        rtf = "" if math.isnan(row["rtf"]) else f" = {row['rtf']:.0f}x real time"
         print(
-            f"  {row['ms_ours']:.2f} ms/scan; log ~{duration:.0f} s; read + odometry "
-            f"{read_s + ours.seconds:.1f} s = {row['rtf']:.0f}x real time",
+            f"  {row['ms_ours']:.2f} ms/scan; log spans {span}; read + odometry "
+            f"{read_s + ours.seconds:.1f} s{rtf}",
             file=sys.stderr,
         )
     print(f"\nMachine: {machine()}\n")
