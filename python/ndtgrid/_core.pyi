@@ -256,7 +256,8 @@ class NdtGrid:
             on a 2 cm grid, 2 on a 20 cm grid. Stage ``l``
             (from ``levels - 1`` down to 0) starts from the previous stage's
             pose and maximises the summed score of its level and the next
-            coarser one, so the last stage includes the fine cells.
+            coarser one (that one as its quadratic model, see
+            ``coarse_model``), so the last stage includes the fine cells.
         coarse_model : bool, default True
             From the second stage on, score the coarser level of the stage by
             its second-order expansion about the stage's start (the same
