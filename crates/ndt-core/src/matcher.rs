@@ -448,6 +448,26 @@ fn stack_terms(
     total
 }
 
+/// The score terms with derivatives of every level of `stack` at `pose`
+/// (from the memo where computed there before).
+fn exact_terms(
+    stack: &[(usize, Arc<Distributions>)],
+    points: &[[f64; 2]],
+    pose: Pose2,
+    options: &MatchOptions,
+    memo: &mut LevelMemo,
+) -> ScoreTerms {
+    stack_terms(
+        stack,
+        points,
+        None,
+        pose,
+        options,
+        Order::Derivatives,
+        Some(memo),
+    )
+}
+
 impl NdtGrid {
     /// Matches scan-frame `points` \[m\] against the grid from `guess`
     /// (`T_map_scan`) by Newton's method on eq. (1).
@@ -533,15 +553,13 @@ impl NdtGrid {
             // From the second stage on, the coarser level of the window is
             // its quadratic model about the stage's start (crate::quadratic).
             let model = match stack.as_slice() {
-                [(coarse, d), _] if options.coarse_model => {
-                    let terms = stack_terms(
-                        &[(*coarse, Arc::clone(d))],
+                [coarse, _] if options.coarse_model => {
+                    let terms = exact_terms(
+                        std::slice::from_ref(coarse),
                         points,
-                        None,
                         pose,
                         options,
-                        Order::Derivatives,
-                        Some(&mut memo),
+                        &mut memo,
                     );
                     Some(QuadraticModel::new(pose, &terms))
                 }
@@ -618,15 +636,7 @@ impl NdtGrid {
             pose = solved.pose;
             if model.is_some() && level == 0 {
                 // The final score and Hessian exactly, both levels scored.
-                solved.terms = stack_terms(
-                    &stack,
-                    points,
-                    None,
-                    pose,
-                    options,
-                    Order::Derivatives,
-                    Some(&mut memo),
-                );
+                solved.terms = exact_terms(&stack, points, pose, options, &mut memo);
             }
             outcome = Some(solved);
         }

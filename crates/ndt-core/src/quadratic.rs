@@ -37,38 +37,11 @@ pub struct QuadraticModel {
 impl QuadraticModel {
     /// The model of the terms `terms` (with derivatives) computed at `at`.
     pub fn new(at: Pose2, terms: &ScoreTerms) -> Self {
-        if !terms.hessian.iter().all(|v| v.is_finite()) {
-            // No eigen-decomposition of a non-finite matrix; the solver
-            // stops on such terms anyway.
-            return Self {
-                at,
-                score: terms.score,
-                gradient: terms.gradient,
-                hessian: terms.hessian,
-                matched: terms.matched,
-            };
-        }
-        // Positive definite (the usual case at the end of a stage): |H| = H.
-        if terms.hessian.cholesky().is_some() {
-            return Self {
-                at,
-                score: terms.score,
-                gradient: terms.gradient,
-                hessian: terms.hessian,
-                matched: terms.matched,
-            };
-        }
-        let eig = SymmetricEigen::new(terms.hessian);
-        let absolute = eig.eigenvectors
-            * Matrix3::from_diagonal(&eig.eigenvalues.map(f64::abs))
-            * eig.eigenvectors.transpose();
-        // Exactly symmetric, like the accumulated Hessians.
-        let hessian = (absolute + absolute.transpose()) * 0.5;
         Self {
             at,
             score: terms.score,
             gradient: terms.gradient,
-            hessian,
+            hessian: absolute(&terms.hessian),
             matched: terms.matched,
         }
     }
@@ -94,6 +67,22 @@ impl QuadraticModel {
             matched: self.matched,
         }
     }
+}
+
+/// `|H|`: `H` with its eigenvalues replaced by their absolute values.
+fn absolute(h: &Matrix3<f64>) -> Matrix3<f64> {
+    // Positive definite (the usual case at the end of a stage): |H| = H. A
+    // non-finite matrix is kept as it is (no eigen-decomposition of it; the
+    // solver stops on such terms anyway).
+    if !h.iter().all(|v| v.is_finite()) || h.cholesky().is_some() {
+        return *h;
+    }
+    let eig = SymmetricEigen::new(*h);
+    let abs = eig.eigenvectors
+        * Matrix3::from_diagonal(&eig.eigenvalues.map(f64::abs))
+        * eig.eigenvectors.transpose();
+    // Exactly symmetric, like the accumulated Hessians.
+    (abs + abs.transpose()) * 0.5
 }
 
 #[cfg(test)]
