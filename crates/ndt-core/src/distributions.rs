@@ -9,6 +9,7 @@ use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::cell::{CellStats, Gaussian, MIN_POINTS};
 use crate::key::CellKey;
+use crate::minority::MinorityMask;
 use crate::shape::Shape;
 use crate::table::{CellTable, Cursor};
 
@@ -38,6 +39,8 @@ pub struct Distributions {
     /// Levels up to the shape level (0: no shape level applies).
     shape_depth: usize,
     map: CellTable<Gaussian>,
+    /// The level's minority cells (with fusion; empty without).
+    minority: MinorityMask,
 }
 
 impl Distributions {
@@ -57,12 +60,18 @@ impl Distributions {
                 map.insert(key, g);
             }
         }
+        let minority = if options.fuse_minority {
+            MinorityMask::of(cells.iter().map(|(k, s)| (*k, s)))
+        } else {
+            MinorityMask::default()
+        };
         Self {
             options,
             level,
             cell_size,
             shape_depth: shape.map_or(0, |s| s.depth()),
             map,
+            minority,
         }
     }
 
@@ -135,6 +144,12 @@ impl Distributions {
                 rest.push(k);
             }
         };
+        if self.options.fuse_minority {
+            for &key in touched {
+                self.minority.set(key, cells.get(&key));
+            }
+        }
+        let mut minority = self.minority.reader();
         for &key in touched {
             if !covered(&key) {
                 add(key);
@@ -144,7 +159,7 @@ impl Distributions {
                 for dy in -1..=1 {
                     for dx in -1..=1 {
                         let n = key.offset(dx, dy);
-                        if cells.get(&n).is_some_and(|s| s.count < MIN_POINTS) && !covered(&n) {
+                        if minority.contains(n) && !covered(&n) {
                             add(n);
                         }
                     }
@@ -201,7 +216,7 @@ impl Distributions {
 
     /// Bytes these distributions hold on the heap, look-up structure included.
     pub fn heap_bytes(&self) -> usize {
-        self.map.heap_bytes()
+        self.map.heap_bytes() + self.minority.heap_bytes()
     }
 
     /// Number of cells with a distribution.

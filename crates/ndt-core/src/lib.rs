@@ -33,6 +33,7 @@ pub mod lanexp;
 pub mod mapper;
 pub mod matcher;
 pub mod memo;
+pub mod minority;
 pub mod neighbor;
 pub mod odometry;
 pub mod persist;
