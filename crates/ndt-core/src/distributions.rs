@@ -8,8 +8,8 @@ use nalgebra::Vector2;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::cell::{CellStats, Gaussian, MIN_POINTS};
+use crate::cellmask::CellMask;
 use crate::key::CellKey;
-use crate::minority::MinorityMask;
 use crate::shape::Shape;
 use crate::table::{CellTable, Cursor};
 
@@ -40,7 +40,7 @@ pub struct Distributions {
     shape_depth: usize,
     map: CellTable<Gaussian>,
     /// The level's minority cells (with fusion; empty without).
-    minority: MinorityMask,
+    minority: CellMask,
 }
 
 impl Distributions {
@@ -61,9 +61,14 @@ impl Distributions {
             }
         }
         let minority = if options.fuse_minority {
-            MinorityMask::of(cells.iter().map(|(k, s)| (*k, s)))
+            CellMask::of(
+                cells
+                    .iter()
+                    .filter(|(_, s)| s.count < MIN_POINTS)
+                    .map(|(k, _)| *k),
+            )
         } else {
-            MinorityMask::default()
+            CellMask::default()
         };
         Self {
             options,
@@ -146,7 +151,8 @@ impl Distributions {
         };
         if self.options.fuse_minority {
             for &key in touched {
-                self.minority.set(key, cells.get(&key));
+                let minority = cells.get(&key).is_some_and(|s| s.count < MIN_POINTS);
+                self.minority.set(key, minority);
             }
         }
         let mut minority = self.minority.reader();

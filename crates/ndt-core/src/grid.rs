@@ -148,6 +148,12 @@ impl NdtGrid {
         f64::from(MAX_INDEX) * self.cell_size
     }
 
+    /// The occupied cells as a bit mask: answers "does this cell hold points?"
+    /// for runs of cells (a beam's path) without touching the sums.
+    pub fn occupancy(&self) -> crate::cellmask::CellMaskReader<'_> {
+        self.pyramid.occupied().reader()
+    }
+
     /// The sums of one cell about its centre, if it holds points.
     pub fn stats(&self, key: CellKey) -> Option<&CellStats> {
         self.fine().get(&key)
@@ -251,7 +257,7 @@ impl NdtGrid {
             .map(|lv| crate::table::hash_map_bytes(lv.cells().capacity(), entry))
             .sum();
         let prepared: usize = self.lock_prepared().iter().map(|d| d.heap_bytes()).sum();
-        sums + prepared
+        sums + self.pyramid.occupied().heap_bytes() + prepared
     }
 
     /// Keys of every occupied cell, in no particular order.

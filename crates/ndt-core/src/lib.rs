@@ -21,6 +21,7 @@
 
 pub mod batch;
 pub mod cell;
+pub mod cellmask;
 pub mod degeneracy;
 pub mod distributions;
 pub mod error;
@@ -33,7 +34,6 @@ pub mod lanexp;
 pub mod mapper;
 pub mod matcher;
 pub mod memo;
-pub mod minority;
 pub mod neighbor;
 pub mod odometry;
 pub mod persist;

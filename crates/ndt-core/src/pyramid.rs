@@ -7,6 +7,7 @@ use nalgebra::Vector2;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 use crate::cell::CellStats;
+use crate::cellmask::CellMask;
 use crate::key::{CellKey, KeyBounds};
 
 /// Most levels a grid may have (fine level included).
@@ -39,6 +40,8 @@ pub struct Pyramid {
     /// A superset of the fine keys in use: grown by every insert, reset when
     /// the fine level empties (removals do not shrink it).
     bounds: Option<KeyBounds>,
+    /// The occupied fine cells, a bit each (see [`crate::cellmask`]).
+    occupied: CellMask,
 }
 
 /// The key of the level-`level` cell covering fine cell `key`: an arithmetic
@@ -63,6 +66,7 @@ impl Pyramid {
         Self {
             levels,
             bounds: None,
+            occupied: CellMask::default(),
         }
     }
 
@@ -70,6 +74,11 @@ impl Pyramid {
     /// more), `None` when the fine level is empty.
     pub fn bounds(&self) -> Option<KeyBounds> {
         self.bounds
+    }
+
+    /// The occupied fine cells.
+    pub fn occupied(&self) -> &CellMask {
+        &self.occupied
     }
 
     /// Number of levels (1 = the fine grid only).
@@ -132,6 +141,9 @@ impl Pyramid {
         }
         if let Some((k, stats)) = run {
             flush(k, &stats);
+        }
+        for &key in &touched {
+            self.occupied.set(key, true);
         }
         if let Some(added) = KeyBounds::of_keys(touched.iter().copied()) {
             self.bounds = Some(match self.bounds {
@@ -199,6 +211,9 @@ impl Pyramid {
                 removed.push(key);
             }
         }
+        for &key in &removed {
+            self.occupied.set(key, false);
+        }
         if self.levels[0].cells.is_empty() {
             self.bounds = None;
         }
@@ -212,6 +227,7 @@ impl Pyramid {
     pub fn set_fine(&mut self, states: &[(CellKey, CellStats)]) {
         self.levels[0].cells = states.iter().copied().collect();
         self.bounds = KeyBounds::of_keys(states.iter().map(|(k, _)| *k));
+        self.occupied = CellMask::of(states.iter().map(|(k, _)| *k));
         for level in &mut self.levels[1..] {
             level.cells.clear();
         }

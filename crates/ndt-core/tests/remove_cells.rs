@@ -72,3 +72,40 @@ fn removal_updates_distributions_like_a_fresh_build() {
         assert!((a.hessian - b.hessian).norm() < 1e-4 * (1.0 + b.hessian.norm()));
     }
 }
+
+/// The grid's occupancy mask (what the §V walks ask first) holds exactly the
+/// cells with sums, through inserts, removals and a rebuild from the states.
+#[test]
+fn occupancy_mask_follows_inserts_removals_and_rebuilds() {
+    let cell = 0.02;
+    let walls = common::room();
+    let mut grid = NdtGrid::new(cell).unwrap();
+    let check = |grid: &NdtGrid| {
+        let bounds = grid.key_bounds().unwrap();
+        let mut occupancy = grid.occupancy();
+        let mut held = 0;
+        for iy in bounds.min.iy - 3..=bounds.max.iy + 3 {
+            for ix in bounds.min.ix - 3..=bounds.max.ix + 3 {
+                let key = CellKey { ix, iy };
+                assert_eq!(
+                    occupancy.contains(key),
+                    grid.stats(key).is_some(),
+                    "{key:?}"
+                );
+                held += usize::from(occupancy.contains(key));
+            }
+        }
+        assert_eq!(held, grid.len());
+    };
+    for i in 0..4u32 {
+        let pose = Pose2::new(0.2 * f64::from(i), -0.1 * f64::from(i), 0.4 * f64::from(i));
+        grid.insert(&common::urg_scan(&walls, pose, 0.005, u64::from(i)), pose)
+            .unwrap();
+        check(&grid);
+        let doomed: Vec<CellKey> = grid.keys().step_by(5).collect();
+        assert_eq!(grid.remove_cells(&doomed), doomed.len());
+        check(&grid);
+    }
+    let rebuilt = NdtGrid::from_cell_states(cell, &grid.cell_states()).unwrap();
+    check(&rebuilt);
+}

@@ -36,8 +36,9 @@ pub fn former_cell_short_of(
         hit - ray * (window / range)
     };
     let mut found = false;
+    let mut occupied = grid.occupancy();
     // The walk crosses the blocks the pyramid shows empty without visiting
-    // them; the cells it visits are looked up.
+    // them; the cells it visits are looked up in the occupancy mask.
     walk_cells_in_skipping(
         start,
         hit,
@@ -45,7 +46,7 @@ pub fn former_cell_short_of(
         grid.key_bounds(),
         &mut grid.occupancy_probe(),
         |key, _, _| {
-            if key != hit_key && grid.stats(key).is_some() {
+            if key != hit_key && occupied.contains(key) {
                 found = true;
             }
             !found

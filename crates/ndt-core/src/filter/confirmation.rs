@@ -103,8 +103,10 @@ pub fn passed_cells(
     let dir = ray / range;
     let reach = range - margin;
     let cell_size = grid.cell_size();
+    let mut occupied = grid.occupancy();
     // The walk crosses the blocks the pyramid shows empty without visiting
-    // them; the cells it visits are looked up.
+    // them; of the cells it visits, those the occupancy mask holds are looked
+    // up.
     walk_cells_in_skipping(
         sensor,
         sensor + dir * reach,
@@ -112,6 +114,9 @@ pub fn passed_cells(
         grid.key_bounds(),
         &mut grid.occupancy_probe(),
         |key, _, _| {
+            if !occupied.contains(key) {
+                return true;
+            }
             let Some(stats) = grid.stats(key) else {
                 return true;
             };

@@ -1,26 +1,24 @@
-//! Which cells of a pyramid level hold fewer than [`MIN_POINTS`] points: the
-//! minority cells of §IV-A(3), whose fused distributions take in the sums of
-//! their 8 neighbours.
+//! A set of cells as one bit per cell, 8 × 8 cells to a 64-bit word.
 //!
-//! When a cell's sums change, every minority cell around it must be
-//! recomputed. Asking the level's hash map about each of the 8 neighbours of
-//! every changed cell costs a cache miss each; this mask answers from one bit
-//! per cell, 8 × 8 cells to a 64-bit word, so a cell's neighbourhood mostly
-//! lies in one word that a small, cache-resident map finds.
+//! Two questions are asked of many cells in a row, where asking the level's
+//! hash map of sums costs a cache miss each: is this neighbour a minority
+//! cell of §IV-A(3) (fewer than [`crate::cell::MIN_POINTS`] points, so its
+//! fused distribution takes in the changed cell's sums)? and does this cell
+//! on a beam's path hold points at all (§V step d walks)? A cell's
+//! neighbourhood, and a run of cells along a beam, mostly lie in one word,
+//! which a small, cache-resident map finds.
 
 use rustc_hash::FxHashMap;
 
-use crate::cell::{CellStats, MIN_POINTS};
 use crate::key::CellKey;
 
 /// log2 of a block's side \[cells\].
 const BLOCK_BITS: i32 = 3;
 const MASK: i32 = (1 << BLOCK_BITS) - 1;
 
-/// One bit per cell, set when the cell exists with fewer than
-/// [`MIN_POINTS`] points.
+/// One bit per cell of a set of cells.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct MinorityMask {
+pub struct CellMask {
     blocks: FxHashMap<(i32, i32), u64>,
 }
 
@@ -31,20 +29,20 @@ fn split(key: CellKey) -> ((i32, i32), u32) {
     (block, bit as u32)
 }
 
-impl MinorityMask {
-    /// The mask of every cell of `cells`.
-    pub fn of<'a>(cells: impl IntoIterator<Item = (CellKey, &'a CellStats)>) -> Self {
+impl CellMask {
+    /// The mask of the cells `keys`.
+    pub fn of(keys: impl IntoIterator<Item = CellKey>) -> Self {
         let mut mask = Self::default();
-        for (key, stats) in cells {
-            mask.set(key, Some(stats));
+        for key in keys {
+            mask.set(key, true);
         }
         mask
     }
 
-    /// Records the sums of `key` now (`None`: the cell is gone).
-    pub fn set(&mut self, key: CellKey, stats: Option<&CellStats>) {
+    /// Puts `key` in the set (`true`) or takes it out.
+    pub fn set(&mut self, key: CellKey, member: bool) {
         let (block, bit) = split(key);
-        if stats.is_some_and(|s| s.count < MIN_POINTS) {
+        if member {
             *self.blocks.entry(block).or_insert(0) |= 1 << bit;
         } else if let Some(word) = self.blocks.get_mut(&block) {
             *word &= !(1 << bit);
@@ -55,8 +53,8 @@ impl MinorityMask {
     }
 
     /// A reader that remembers the last block it used.
-    pub fn reader(&self) -> MinorityReader<'_> {
-        MinorityReader {
+    pub fn reader(&self) -> CellMaskReader<'_> {
+        CellMaskReader {
             mask: self,
             last: None,
         }
@@ -72,16 +70,16 @@ impl MinorityMask {
     }
 }
 
-/// Reads a [`MinorityMask`] remembering the last block (a cell's
-/// neighbourhood mostly lies in one).
+/// Reads a [`CellMask`] remembering the last block (a cell's neighbourhood
+/// and a run of cells along a beam mostly lie in one).
 #[derive(Debug)]
-pub struct MinorityReader<'a> {
-    mask: &'a MinorityMask,
+pub struct CellMaskReader<'a> {
+    mask: &'a CellMask,
     last: Option<((i32, i32), u64)>,
 }
 
-impl MinorityReader<'_> {
-    /// `true` when `key` is a minority cell.
+impl CellMaskReader<'_> {
+    /// `true` when `key` is in the set.
     #[inline]
     pub fn contains(&mut self, key: CellKey) -> bool {
         let (block, bit) = split(key);
@@ -100,6 +98,7 @@ impl MinorityReader<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cell::{CellStats, MIN_POINTS};
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
 
@@ -107,7 +106,7 @@ mod tests {
     fn agrees_with_the_counts_under_random_changes() {
         let mut rng = StdRng::seed_from_u64(5);
         let mut cells: FxHashMap<CellKey, CellStats> = FxHashMap::default();
-        let mut mask = MinorityMask::default();
+        let mut mask = CellMask::default();
         for _ in 0..20_000 {
             let key = CellKey {
                 ix: rng.random_range(-20..20),
@@ -118,9 +117,14 @@ mod tests {
             } else {
                 cells.entry(key).or_default().count += rng.random_range(1..3);
             }
-            mask.set(key, cells.get(&key));
+            mask.set(key, cells.get(&key).is_some_and(|s| s.count < MIN_POINTS));
         }
-        let rebuilt = MinorityMask::of(cells.iter().map(|(k, s)| (*k, s)));
+        let rebuilt = CellMask::of(
+            cells
+                .iter()
+                .filter(|(_, s)| s.count < MIN_POINTS)
+                .map(|(k, _)| *k),
+        );
         assert_eq!(rebuilt, mask);
         let mut reader = mask.reader();
         for iy in -22..22 {
