@@ -93,8 +93,10 @@ impl MapFilter {
     /// Cells too young for step c are left alone. Returns the number of
     /// cells deleted.
     pub fn run_checks(&mut self, grid: &mut NdtGrid) -> usize {
-        // Forget cells that left the grid by other means.
-        self.table.retain(|k, _| grid.stats(*k).is_some());
+        // Forget cells that left the grid by other means (asked of the
+        // grid's occupancy mask, not its sums: the whole table every check).
+        let mut occupied = grid.occupancy();
+        self.table.retain(|k, _| occupied.contains(*k));
         let mut removed = 0;
         if self.options.on(self.options.area1_confirmation) {
             let keys = unconfirmed_small(&self.table);

@@ -150,9 +150,10 @@ impl MapFilter {
         }
         // Cells in the grid that the filter has not seen (inserted into the
         // grid directly) count as established when first hit.
+        let mut occupied = grid.occupancy();
         let foreign: FxHashSet<CellKey> = hit_set
             .iter()
-            .filter(|k| grid.stats(**k).is_some() && !self.table.contains_key(k))
+            .filter(|k| occupied.contains(**k) && !self.table.contains_key(k))
             .copied()
             .collect();
         // Commit: the only fallible call comes first.
