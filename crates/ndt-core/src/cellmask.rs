@@ -39,17 +39,43 @@ impl CellMask {
         mask
     }
 
-    /// Puts `key` in the set (`true`) or takes it out.
-    pub fn set(&mut self, key: CellKey, member: bool) {
-        let (block, bit) = split(key);
+    /// Puts every key of `keys` in the set (`true`) or takes them out: one
+    /// look-up per run of keys in one block (a scan's cells come in runs
+    /// along its surfaces), otherwise as [`CellMask::set`] key by key.
+    pub fn set_all(&mut self, keys: &[CellKey], member: bool) {
+        let mut run: Option<((i32, i32), u64)> = None;
+        for &key in keys {
+            let (block, bit) = split(key);
+            match &mut run {
+                Some((b, bits)) if *b == block => *bits |= 1 << bit,
+                _ => {
+                    if let Some((b, bits)) = run.take() {
+                        self.apply(b, bits, member);
+                    }
+                    run = Some((block, 1 << bit));
+                }
+            }
+        }
+        if let Some((b, bits)) = run {
+            self.apply(b, bits, member);
+        }
+    }
+
+    fn apply(&mut self, block: (i32, i32), bits: u64, member: bool) {
         if member {
-            *self.blocks.entry(block).or_insert(0) |= 1 << bit;
+            *self.blocks.entry(block).or_insert(0) |= bits;
         } else if let Some(word) = self.blocks.get_mut(&block) {
-            *word &= !(1 << bit);
+            *word &= !bits;
             if *word == 0 {
                 self.blocks.remove(&block);
             }
         }
+    }
+
+    /// Puts `key` in the set (`true`) or takes it out.
+    pub fn set(&mut self, key: CellKey, member: bool) {
+        let (block, bit) = split(key);
+        self.apply(block, 1 << bit, member);
     }
 
     /// A reader that remembers the last block it used.
@@ -119,6 +145,16 @@ mod tests {
             }
             mask.set(key, cells.get(&key).is_some_and(|s| s.count < MIN_POINTS));
         }
+        // The same changes in runs give the same mask.
+        let mut runs = CellMask::default();
+        let keys: Vec<CellKey> = cells.keys().copied().collect();
+        runs.set_all(&keys, true);
+        let gone: Vec<CellKey> = keys
+            .iter()
+            .copied()
+            .filter(|k| cells.get(k).is_some_and(|s| s.count >= MIN_POINTS))
+            .collect();
+        runs.set_all(&gone, false);
         let rebuilt = CellMask::of(
             cells
                 .iter()
@@ -126,6 +162,7 @@ mod tests {
                 .map(|(k, _)| *k),
         );
         assert_eq!(rebuilt, mask);
+        assert_eq!(runs, mask);
         let mut reader = mask.reader();
         for iy in -22..22 {
             for ix in -22..22 {

@@ -142,9 +142,7 @@ impl Pyramid {
         if let Some((k, stats)) = run {
             flush(k, &stats);
         }
-        for &key in &touched {
-            self.occupied.set(key, true);
-        }
+        self.occupied.set_all(&touched, true);
         if let Some(added) = KeyBounds::of_keys(touched.iter().copied()) {
             self.bounds = Some(match self.bounds {
                 Some(b) => b.including(added.min).including(added.max),
@@ -211,9 +209,7 @@ impl Pyramid {
                 removed.push(key);
             }
         }
-        for &key in &removed {
-            self.occupied.set(key, false);
-        }
+        self.occupied.set_all(&removed, false);
         if self.levels[0].cells.is_empty() {
             self.bounds = None;
         }
