@@ -276,7 +276,7 @@ class NdtGrid:
             ``RAYON_NUM_THREADS`` limits it), in fixed chunks of 2048 points
             summed in order: the pose does not depend on the number of threads
             and differs from the one-thread result in the last bits. Off by
-            default: on 2 cores 16384 / 32000 points gained 1.42 / 1.50x (8192
+            default: on 2 cores 16384 / 32000 points gained 1.26-1.42 / 1.44-1.50x (8192
             did not), and Python threads matching different scans use the cores
             better (the GIL is released).
 

@@ -149,8 +149,8 @@ pub struct MatchOptions {
     /// of [`PARALLEL_CHUNK`] points summed in order, so the result does not
     /// depend on the number of threads; it differs from the one-thread sum in
     /// the last bits. Off by default: on 2 cores (`cargo bench --bench core --
-    /// match_large`, synthetic room, 2 cm) 16384 / 32000 points match 1.42 /
-    /// 1.50× faster (session 5); 8192 points did not gain (hence the threshold), and with
+    /// match_large`, synthetic room, 2 cm) 16384 / 32000 points match 1.26–1.42
+    /// / 1.44–1.50× faster (two runs, session 5); 8192 points did not gain (hence the threshold), and with
     /// 256-point chunks 2000 points were 2.3× slower (each of a match's ~40
     /// evaluations wakes the pool). Python threads matching different scans
     /// use the cores better (the GIL is released while matching).
