@@ -565,24 +565,20 @@ impl NdtGrid {
                 }
                 _ => None,
             };
-            let own = stack.len() - 1;
-            let mut objective = |p: Pose2, order: Order| match &model {
-                Some(m) => {
-                    let mut t = stack_terms(
-                        &stack[own..],
-                        points,
-                        None,
-                        p,
-                        options,
-                        order,
-                        Some(&mut memo),
-                    );
+            // The levels scored point by point: with the model, the stage's own.
+            let scored = if model.is_some() {
+                &stack[stack.len() - 1..]
+            } else {
+                &stack[..]
+            };
+            let mut objective = |p: Pose2, order: Order| {
+                let mut t = stack_terms(scored, points, None, p, options, order, Some(&mut memo));
+                if let Some(m) = &model {
                     let coarse = m.terms(p);
                     t.add_terms(&coarse);
                     t.matched = t.matched.max(coarse.matched);
-                    t
                 }
-                None => stack_terms(&stack, points, None, p, options, order, Some(&mut memo)),
+                t
             };
             let mut solved = minimise(pose, &solver, &mut objective);
             // The first (coarsest) stage also starts from the guess rotated
