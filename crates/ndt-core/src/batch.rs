@@ -351,7 +351,7 @@ mod tests {
                     assert!(b.hessian[(2, 2)] != 0.0);
                     // The information of the own-cell pairs only, unweighted.
                     let want = crate::information::point_to_plane_information(
-                        own_pairs.iter().copied(),
+                        own_pairs.iter().map(|&(x, g)| (x, *g)),
                         Pose2::new(0.0, 0.0, 0.3),
                     );
                     let scale = want.abs().max();

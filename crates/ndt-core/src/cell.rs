@@ -85,14 +85,18 @@ impl CellStats {
         }
     }
 
+    /// eq. (7): the mean about the origin, `q − o = m / M`. `None` for an
+    /// empty cell.
+    #[inline]
+    pub fn mean(&self) -> Option<Vector2<f64>> {
+        (self.count > 0).then(|| self.sum / self.count as f64)
+    }
+
     /// eq. (7): mean about the origin `q − o = m / M` and covariance
     /// `Σ = (S − q mᵀ) / M` (shift invariant). `None` for an empty cell.
     pub fn mean_and_covariance(&self) -> Option<(Vector2<f64>, Matrix2<f64>)> {
-        if self.count == 0 {
-            return None;
-        }
+        let q = self.mean()?;
         let n = self.count as f64;
-        let q = self.sum / n;
         let mut cov = (self.scatter - q * self.sum.transpose()) / n;
         // Symmetrise against round-off.
         let off = 0.5 * (cov[(0, 1)] + cov[(1, 0)]);

@@ -11,6 +11,7 @@ use crate::cell::{CellStats, Gaussian, MIN_POINTS};
 use crate::cellmask::CellMask;
 use crate::key::CellKey;
 use crate::shape::Shape;
+use crate::shaped::{Ancestor, ShapedCursor, ShapedStore};
 use crate::table::{CellTable, Cursor};
 
 /// What decides a cell's distribution besides its sums.
@@ -38,9 +39,25 @@ pub struct Distributions {
     cell_size: f64,
     /// Levels up to the shape level (0: no shape level applies).
     shape_depth: usize,
-    map: CellTable<Gaussian>,
+    store: Store,
     /// The level's minority cells (with fusion; empty without).
     minority: CellMask,
+}
+
+/// A distribution starting on a cache line: a [`Gaussian`] is 64 bytes, so
+/// each one takes exactly one line and a look-up touches one line, not two.
+#[derive(Debug, Clone, Copy)]
+#[repr(align(64))]
+struct Line(Gaussian);
+
+/// How the distributions are kept.
+#[derive(Debug, Clone)]
+enum Store {
+    /// Each cell its own (no shape level).
+    Own(CellTable<Line>),
+    /// Cells under an ancestor with a shape share its covariance part
+    /// ([`crate::shaped`]).
+    Shaped(ShapedStore),
 }
 
 impl Distributions {
@@ -53,13 +70,29 @@ impl Distributions {
         options: DistOptions,
         shape: Option<Shape<'_>>,
     ) -> Self {
-        let mut map = CellTable::with_capacity(cells.len());
-        let mut shapes = ShapeCache::default();
-        for &key in cells.keys() {
-            if let Some(g) = distribution_of(cells, cell_size, options, shape, &mut shapes, key) {
-                map.insert(key, g);
+        let store = match shape {
+            None => {
+                let mut map = CellTable::with_capacity(cells.len());
+                for &key in cells.keys() {
+                    if let Some(g) = own_distribution(cells, cell_size, options, key) {
+                        map.insert(key, Line(g));
+                    }
+                }
+                Store::Own(map)
             }
-        }
+            Some(s) => {
+                let mut store = ShapedStore::with_capacity(cells.len());
+                // Every ancestor's shape once, then every cell.
+                for &at in s.cells().keys() {
+                    store.set_ancestor(at, shape_of_ancestor(s, at, options));
+                }
+                for (&key, own) in cells {
+                    let at = crate::pyramid::coarse_key(key, s.depth());
+                    set_cell(&mut store, cells, cell_size, options, at, key, own);
+                }
+                Store::Shaped(store)
+            }
+        };
         let minority = if options.fuse_minority {
             CellMask::of(
                 cells
@@ -75,7 +108,7 @@ impl Distributions {
             level,
             cell_size,
             shape_depth: shape.map_or(0, |s| s.depth()),
-            map,
+            store,
             minority,
         }
     }
@@ -88,9 +121,12 @@ impl Distributions {
 
     /// Recomputes the cells whose distribution may have changed after the
     /// cells `touched` gained or lost points: those cells, with fusion their 8
-    /// neighbours (whose fused sums include them), and with a shape level
-    /// every cell under the same ancestors (`shape`: that level, whose cells
-    /// must already include the change; the same depth as at build).
+    /// neighbours (whose fused sums include them), and with a shape level the
+    /// touched cells' ancestors (`shape`: that level, whose cells must
+    /// already include the change; the same depth as at build). An ancestor
+    /// whose shape changed only in value is written once for all the cells
+    /// under it ([`crate::shaped`]); one that gained or lost its shape sets
+    /// every cell under it again.
     pub fn update(
         &mut self,
         cells: &FxHashMap<CellKey, CellStats>,
@@ -98,97 +134,25 @@ impl Distributions {
         touched: &[CellKey],
         shape: Option<Shape<'_>>,
     ) {
-        let mut shapes = ShapeCache::default();
-        // With a shape level: every cell under a touched ancestor (the
-        // touched cells that still exist among them), each once.
-        let mut ancestors = FxHashSet::default();
-        if let Some(s) = shape {
-            ancestors = touched
-                .iter()
-                .map(|&k| crate::pyramid::coarse_key(k, s.depth()))
-                .collect();
-            // Each ancestor's shape once, then its cells (as distribution_of
-            // would give them; cells of an ancestor without a shape of its
-            // own take the paper's distribution there).
-            let mut current: Option<(CellKey, Option<Option<Gaussian>>)> = None;
-            for (ancestor, key, own) in s.descendants(&ancestors) {
-                let shaped = match current {
-                    Some((a, shaped)) if a == ancestor => shaped,
-                    _ => {
-                        let shaped = shape_of_ancestor(s, ancestor, self.options);
-                        current = Some((ancestor, shaped));
-                        shaped
-                    }
-                };
-                match shaped {
-                    Some(covariance) => match in_shape(own, key.center(cell_size), &covariance) {
-                        Some(g) => self.map.insert(key, g),
-                        None => self.map.remove(key),
-                    },
-                    None => self.recompute(cells, cell_size, shape, &mut shapes, key),
-                }
-            }
-        }
-        // The rest: touched cells not covered above (all of them without a
-        // shape level; with one, those that lost their last point), and with
-        // fusion the minority neighbours, whose fused sums include them.
-        let covered = |k: &CellKey| match shape {
-            Some(s) => {
-                cells.contains_key(k)
-                    && ancestors.contains(&crate::pyramid::coarse_key(*k, s.depth()))
-            }
-            None => false,
-        };
-        // In the order met (a scan's cells come in runs along its surfaces,
-        // so consecutive inserts mostly share a tile of the table).
-        let mut seen: FxHashSet<CellKey> =
-            FxHashSet::with_capacity_and_hasher(touched.len() * 2, Default::default());
-        let mut rest = Vec::with_capacity(touched.len() * 2);
-        let mut add = |k: CellKey| {
-            if seen.insert(k) {
-                rest.push(k);
-            }
-        };
         if self.options.fuse_minority {
             for &key in touched {
                 let minority = cells.get(&key).is_some_and(|s| s.count < MIN_POINTS);
                 self.minority.set(key, minority);
             }
         }
-        let mut minority = self.minority.reader();
-        for &key in touched {
-            if !covered(&key) {
-                add(key);
+        let options = self.options;
+        match (&mut self.store, shape) {
+            (Store::Shaped(store), Some(s)) => {
+                update_shaped(store, &self.minority, cells, cell_size, options, touched, s);
             }
-            if self.options.fuse_minority {
-                // Only minority neighbours use the fused sums that include `key`.
-                for dy in -1..=1 {
-                    for dx in -1..=1 {
-                        let n = key.offset(dx, dy);
-                        if minority.contains(n) && !covered(&n) {
-                            add(n);
-                        }
-                    }
-                }
+            (Store::Own(map), _) => {
+                update_own(map, &self.minority, cells, cell_size, options, touched);
             }
-        }
-        for key in rest {
-            self.recompute(cells, cell_size, shape, &mut shapes, key);
-        }
-    }
-
-    /// Sets (or removes) the distribution of `key` from the sums.
-    fn recompute(
-        &mut self,
-        cells: &FxHashMap<CellKey, CellStats>,
-        cell_size: f64,
-        shape: Option<Shape<'_>>,
-        shapes: &mut ShapeCache,
-        key: CellKey,
-    ) {
-        match distribution_of(cells, cell_size, self.options, shape, shapes, key) {
-            Some(g) => self.map.insert(key, g),
-            None => self.map.remove(key),
+            // Built with a shape level, updated without one: cannot happen
+            // (the grid passes the same depth); rebuild rather than go stale.
+            (Store::Shaped(_), None) => {
+                *self = Self::build(cells, cell_size, self.level, options, None);
+            }
         }
     }
 
@@ -209,42 +173,301 @@ impl Distributions {
 
     /// The distribution of cell `key`, if it has one.
     #[inline]
-    pub fn get(&self, key: CellKey) -> Option<&Gaussian> {
-        self.map.get(key)
+    pub fn get(&self, key: CellKey) -> Option<Gaussian> {
+        self.cursor().get(key)
     }
 
     /// A reader for runs of look-ups (a scan's points in order, a cell's
     /// neighbours): see [`crate::table::Cursor`].
     #[inline]
-    pub fn cursor(&self) -> Cursor<'_, Gaussian> {
-        self.map.cursor()
+    pub fn cursor(&self) -> DistCursor<'_> {
+        match &self.store {
+            Store::Own(map) => DistCursor(CursorKind::Own(OwnCursor(map.cursor()))),
+            Store::Shaped(store) => DistCursor(CursorKind::Shaped(store.cursor())),
+        }
     }
 
     /// Bytes these distributions hold on the heap, look-up structure included.
     pub fn heap_bytes(&self) -> usize {
-        self.map.heap_bytes() + self.minority.heap_bytes()
+        let store = match &self.store {
+            Store::Own(map) => map.heap_bytes(),
+            Store::Shaped(store) => store.heap_bytes(),
+        };
+        store + self.minority.heap_bytes()
     }
 
     /// Number of cells with a distribution.
     pub fn len(&self) -> usize {
-        self.map.len()
+        match &self.store {
+            Store::Own(map) => map.len(),
+            Store::Shaped(store) => store.len(),
+        }
     }
 
     /// `true` when no cell has a distribution.
     pub fn is_empty(&self) -> bool {
-        self.map.is_empty()
+        self.len() == 0
     }
 }
 
-/// The covariance part of each ancestor's shaped distribution
-/// ([`Gaussian::shape_of`]), computed once per ancestor in a build or update
-/// rather than once per fine cell under it: `None` when the ancestor has fewer
-/// than [`MIN_POINTS`] points (its cells keep their own distributions),
-/// `Some(None)` when it has no distribution.
-type ShapeCache = FxHashMap<CellKey, Option<Option<Gaussian>>>;
+/// Reads [`Distributions`] for runs of look-ups (see [`crate::table::Cursor`]).
+#[derive(Debug)]
+pub struct DistCursor<'a>(CursorKind<'a>);
 
-/// The covariance part of the shaped distributions under ancestor `at` (see
-/// [`ShapeCache`] for the two levels of `None`).
+#[derive(Debug)]
+enum CursorKind<'a> {
+    Own(OwnCursor<'a>),
+    Shaped(ShapedCursor<'a>),
+}
+
+impl DistCursor<'_> {
+    /// The distribution of cell `key`, if it has one.
+    #[inline]
+    pub fn get(&mut self, key: CellKey) -> Option<Gaussian> {
+        match &mut self.0 {
+            CursorKind::Own(c) => DistLookup::get(c, key).copied(),
+            CursorKind::Shaped(c) => c.get(key),
+        }
+    }
+}
+
+/// Look-ups of distributions by cell, for code generic over how they are
+/// kept (the matcher's inner loop: [`Distributions::visit`]).
+pub trait DistLookup {
+    /// What a look-up gives: a reference where the distribution is stored
+    /// whole, a value where it is assembled.
+    type Dist: std::borrow::Borrow<Gaussian> + Copy;
+    /// The distribution of cell `key`, if it has one.
+    fn get(&mut self, key: CellKey) -> Option<Self::Dist>;
+}
+
+/// Code run with the reader of [`Distributions`] of whichever kind they are
+/// ([`Distributions::visit`]): one branch per call instead of one per look-up.
+pub trait CursorVisitor {
+    /// What the code returns.
+    type Out;
+    /// Runs the code with `cursor`.
+    fn visit<L: DistLookup>(self, cursor: L) -> Self::Out;
+}
+
+impl Distributions {
+    /// Runs `visitor` with a reader of these distributions.
+    #[inline]
+    pub fn visit<V: CursorVisitor>(&self, visitor: V) -> V::Out {
+        match &self.store {
+            Store::Own(map) => visitor.visit(OwnCursor(map.cursor())),
+            Store::Shaped(store) => visitor.visit(store.cursor()),
+        }
+    }
+}
+
+/// Reads distributions stored whole.
+#[derive(Debug)]
+pub struct OwnCursor<'a>(Cursor<'a, Line>);
+
+impl<'a> DistLookup for OwnCursor<'a> {
+    type Dist = &'a Gaussian;
+    #[inline(always)]
+    fn get(&mut self, key: CellKey) -> Option<&'a Gaussian> {
+        self.0.get(key).map(|l| &l.0)
+    }
+}
+
+impl DistLookup for ShapedCursor<'_> {
+    type Dist = Gaussian;
+    #[inline(always)]
+    fn get(&mut self, key: CellKey) -> Option<Gaussian> {
+        ShapedCursor::get(self, key)
+    }
+}
+
+impl DistLookup for DistCursor<'_> {
+    type Dist = Gaussian;
+    #[inline]
+    fn get(&mut self, key: CellKey) -> Option<Gaussian> {
+        DistCursor::get(self, key)
+    }
+}
+
+/// [`Distributions::update`] without a shape level: the touched cells and,
+/// with fusion, their minority neighbours, in the order met (a scan's cells
+/// come in runs along its surfaces, so consecutive inserts mostly share a
+/// tile of the table).
+fn update_own(
+    map: &mut CellTable<Line>,
+    minority: &CellMask,
+    cells: &FxHashMap<CellKey, CellStats>,
+    cell_size: f64,
+    options: DistOptions,
+    touched: &[CellKey],
+) {
+    let rest = with_minority_neighbours(minority, options, touched, |_| true);
+    for key in rest {
+        match own_distribution(cells, cell_size, options, key) {
+            Some(g) => map.insert(key, Line(g)),
+            None => map.remove(key),
+        }
+    }
+}
+
+/// `touched`, and with fusion every minority neighbour of a touched cell
+/// (only those use fused sums that include it) for which `wanted` holds; each
+/// once, in the order met.
+fn with_minority_neighbours(
+    minority: &CellMask,
+    options: DistOptions,
+    touched: &[CellKey],
+    mut wanted: impl FnMut(CellKey) -> bool,
+) -> Vec<CellKey> {
+    let mut seen: FxHashSet<CellKey> =
+        FxHashSet::with_capacity_and_hasher(touched.len() * 2, Default::default());
+    let mut rest = Vec::with_capacity(touched.len() * 2);
+    let mut reader = minority.reader();
+    for &key in touched {
+        if wanted(key) && seen.insert(key) {
+            rest.push(key);
+        }
+        if options.fuse_minority {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let n = key.offset(dx, dy);
+                    if reader.contains(n) && wanted(n) && seen.insert(n) {
+                        rest.push(n);
+                    }
+                }
+            }
+        }
+    }
+    rest
+}
+
+/// [`Distributions::update`] with a shape level (see there).
+fn update_shaped(
+    store: &mut ShapedStore,
+    minority: &CellMask,
+    cells: &FxHashMap<CellKey, CellStats>,
+    cell_size: f64,
+    options: DistOptions,
+    touched: &[CellKey],
+    s: Shape<'_>,
+) {
+    let depth = s.depth();
+    let ancestor_of = |k: CellKey| crate::pyramid::coarse_key(k, depth);
+    // The touched cells' ancestors, each once (a scan's cells come in runs
+    // under one ancestor): those whose kind changed set all their cells again.
+    let mut seen = FxHashSet::with_capacity_and_hasher(touched.len() / 4, Default::default());
+    let mut changed = FxHashSet::default();
+    let mut last = None;
+    for &key in touched {
+        let at = ancestor_of(key);
+        if last != Some(at) {
+            last = Some(at);
+            if seen.insert(at) && store.set_ancestor(at, shape_of_ancestor(s, at, options)) {
+                changed.insert(at);
+            }
+        }
+    }
+    if !changed.is_empty() {
+        for (at, key, own) in s.descendants(&changed) {
+            set_cell(store, cells, cell_size, options, at, key, own);
+        }
+    }
+    // What an ancestor is now, `None` when it changed kind (its cells are
+    // set above); the last one asked about remembered.
+    let mut kinds = AncestorKinds {
+        changed: &changed,
+        last: None,
+    };
+    // The other touched cells: gone, a new mean under a shape, or a new
+    // distribution of their own without one (then with fusion their
+    // minority neighbours' too).
+    let mut own = Vec::new();
+    let mut own_seen = FxHashSet::default();
+    let mut reader = minority.reader();
+    for &key in touched {
+        match (cells.get(&key), kinds.of(store, ancestor_of(key))) {
+            (None, _) => store.remove(key),
+            (Some(stats), Some(Ancestor::Shaped(slot))) => {
+                if let Some(mean) = stats.mean() {
+                    store.set_shared(key, key.center(cell_size) + mean, slot);
+                }
+            }
+            (Some(_), Some(Ancestor::Unshaped)) => {
+                if own_seen.insert(key) {
+                    own.push(key);
+                }
+            }
+            (Some(_), Some(Ancestor::Blocked) | None) => {}
+        }
+        // A cell gone or changed changes its minority neighbours' fused sums.
+        if options.fuse_minority {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let n = key.offset(dx, dy);
+                    if (dx, dy) != (0, 0)
+                        && reader.contains(n)
+                        && kinds.of(store, ancestor_of(n)) == Some(Ancestor::Unshaped)
+                        && own_seen.insert(n)
+                    {
+                        own.push(n);
+                    }
+                }
+            }
+        }
+    }
+    for key in own {
+        store.set_own(key, own_distribution(cells, cell_size, options, key));
+    }
+}
+
+/// The kinds of ancestors during one shaped update, remembering the last
+/// one asked about.
+struct AncestorKinds<'a> {
+    changed: &'a FxHashSet<CellKey>,
+    last: Option<(CellKey, Option<Ancestor>)>,
+}
+
+impl AncestorKinds<'_> {
+    /// `None` for an ancestor that changed kind in this update.
+    #[inline]
+    fn of(&mut self, store: &ShapedStore, at: CellKey) -> Option<Ancestor> {
+        match self.last {
+            Some((k, kind)) if k == at => kind,
+            _ => {
+                let kind = (!self.changed.contains(&at)).then(|| store.ancestor(at));
+                self.last = Some((at, kind));
+                kind
+            }
+        }
+    }
+}
+
+/// Sets cell `key` (sums `own`) under ancestor `at` as the ancestor's kind
+/// says (see [`Ancestor`]).
+fn set_cell(
+    store: &mut ShapedStore,
+    cells: &FxHashMap<CellKey, CellStats>,
+    cell_size: f64,
+    options: DistOptions,
+    at: CellKey,
+    key: CellKey,
+    own: &CellStats,
+) {
+    match store.ancestor(at) {
+        Ancestor::Shaped(slot) => {
+            if let Some(mean) = own.mean() {
+                store.set_shared(key, key.center(cell_size) + mean, slot);
+            }
+        }
+        Ancestor::Blocked => store.remove(key),
+        Ancestor::Unshaped => store.set_own(key, own_distribution(cells, cell_size, options, key)),
+    }
+}
+
+/// The covariance part of the shaped distributions under ancestor `at`
+/// ([`Gaussian::shape_of`]): `None` when the ancestor has fewer than
+/// [`MIN_POINTS`] points (its cells keep their own distributions),
+/// `Some(None)` when it has no distribution.
 fn shape_of_ancestor(s: Shape<'_>, at: CellKey, options: DistOptions) -> Option<Option<Gaussian>> {
     s.cells()
         .get(&at)
@@ -252,38 +475,17 @@ fn shape_of_ancestor(s: Shape<'_>, at: CellKey, options: DistOptions) -> Option<
         .map(|region| Gaussian::shape_of(region, options.sigma_floor, options.expansion))
 }
 
-/// A cell's shaped distribution: its own mean, the ancestor's covariance
-/// part (`None`: the ancestor has no distribution, nor has the cell).
-fn in_shape(
-    own: &CellStats,
-    centre: Vector2<f64>,
-    covariance: &Option<Gaussian>,
-) -> Option<Gaussian> {
-    Gaussian::from_shape(own, centre, covariance.as_ref()?)
-}
-
-/// The distribution of one cell under `options`, from the sums alone.
-fn distribution_of(
+/// The paper's distribution of one cell under `options`, from the sums alone:
+/// eq. (7) expanded by eq. (8), fused with the neighbours for a minority cell
+/// (§IV-A(3)).
+fn own_distribution(
     cells: &FxHashMap<CellKey, CellStats>,
     cell_size: f64,
     options: DistOptions,
-    shape: Option<Shape<'_>>,
-    shapes: &mut ShapeCache,
     key: CellKey,
 ) -> Option<Gaussian> {
     let own = cells.get(&key)?;
     let centre = key.center(cell_size);
-    // Own mean, the ancestor's covariance (crate::shape), when the ancestor
-    // has a distribution of its own (Gaussian::with_shape, bit for bit).
-    if let Some(s) = shape {
-        let at = crate::pyramid::coarse_key(key, s.depth());
-        let shaped = shapes
-            .entry(at)
-            .or_insert_with(|| shape_of_ancestor(s, at, options));
-        if let Some(covariance) = shaped {
-            return in_shape(own, centre, covariance);
-        }
-    }
     if own.count >= MIN_POINTS || !options.fuse_minority {
         return Gaussian::from_stats(own, centre, options.sigma_floor, options.expansion);
     }
@@ -299,4 +501,78 @@ fn distribution_of(
         }
     }
     Gaussian::from_stats(&fused, centre, options.sigma_floor, options.expansion)
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::grid::NdtGrid;
+    use crate::se2::Pose2;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    /// Every level's kept distributions equal a fresh build, cell by cell.
+    fn assert_as_built(grid: &NdtGrid, options: DistOptions) {
+        let fresh = NdtGrid::from_cell_states(grid.cell_size(), &grid.cell_states()).unwrap();
+        for level in 0..grid.levels() {
+            let kept = grid.distributions(level, options).unwrap();
+            let built = fresh.distributions(level, options).unwrap();
+            assert_eq!(kept.len(), built.len(), "level {level}");
+            let cells = grid
+                .level(level)
+                .map(|l| l.cells().keys().copied().collect::<Vec<_>>());
+            for key in cells.unwrap_or_default() {
+                assert_eq!(kept.get(key), built.get(key), "level {level} cell {key:?}");
+            }
+        }
+    }
+
+    /// Inserts and removals that take ancestors across the 3-point bound both
+    /// ways, make some shapeless (coincident points with a σ floor of
+    /// 1e-200: no finite distribution) and move cells in and out of fusion.
+    #[test]
+    fn kept_distributions_equal_a_fresh_build_under_inserts_and_removals() {
+        for (shape_cell, sigma_floor, fuse_minority) in [
+            (0.32, 0.02, true),
+            (0.32, 0.02, false),
+            (0.08, 1e-200, true),
+            (0.0, 0.005, true),
+        ] {
+            let options = DistOptions {
+                expansion: 10.0,
+                fuse_minority,
+                sigma_floor,
+                shape_cell,
+            };
+            let mut rng = StdRng::seed_from_u64(11);
+            let mut grid = NdtGrid::new(0.02).unwrap();
+            grid.insert(&[[0.0, 0.0]], Pose2::identity()).unwrap();
+            for step in 0..60 {
+                // Prepare every level, then change the map under them.
+                for level in 0..grid.levels() {
+                    let _ = grid.distributions(level, options);
+                }
+                if step % 4 == 3 {
+                    let keys: Vec<CellKey> = grid.keys().filter(|_| rng.random_bool(0.3)).collect();
+                    grid.remove_cells(&keys);
+                } else {
+                    // A few clusters of 1 to 4 points, some coincident.
+                    let mut pts = Vec::new();
+                    for _ in 0..rng.random_range(1..6) {
+                        let c = [rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)];
+                        for _ in 0..rng.random_range(1..5) {
+                            if rng.random_bool(0.5) {
+                                pts.push(c);
+                            } else {
+                                pts.push([c[0] + rng.random_range(-0.05..0.05), c[1]]);
+                            }
+                        }
+                    }
+                    grid.insert(&pts, Pose2::identity()).unwrap();
+                }
+                assert_as_built(&grid, options);
+            }
+        }
+    }
 }

@@ -14,8 +14,8 @@ use crate::se2::Pose2;
 
 /// `A = Σ Jᵢᵀ nᵢ nᵢᵀ Jᵢ` over `(point, distribution)` pairs, in the order
 /// `x, y, θ`, with `Jᵢ = ∂x'ᵢ/∂p` of eq. (2) at `pose`.
-pub fn point_to_plane_information<'a>(
-    pairs: impl Iterator<Item = (Vector2<f64>, &'a crate::cell::Gaussian)>,
+pub fn point_to_plane_information(
+    pairs: impl Iterator<Item = (Vector2<f64>, crate::cell::Gaussian)>,
     pose: Pose2,
 ) -> Matrix3<f64> {
     let (s, c) = pose.theta.sin_cos();
@@ -38,7 +38,7 @@ pub fn own_cell_pairs<'a>(
     dists: &'a Distributions,
     points: &'a [[f64; 2]],
     pose: Pose2,
-) -> impl Iterator<Item = (Vector2<f64>, &'a crate::cell::Gaussian)> + 'a {
+) -> impl Iterator<Item = (Vector2<f64>, crate::cell::Gaussian)> + 'a {
     let inv = 1.0 / dists.cell_size();
     let mut cursor = dists.cursor();
     let sin_cos = pose.theta.sin_cos();

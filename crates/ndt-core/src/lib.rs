@@ -44,6 +44,7 @@ pub mod reduce;
 pub mod score;
 pub mod se2;
 pub mod shape;
+pub mod shaped;
 pub mod solver;
 pub mod table;
 

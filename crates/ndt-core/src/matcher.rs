@@ -1,13 +1,14 @@
 //! NDT scan matching against an [`NdtGrid`] (§III-A with the fixes of §IV-A).
 
+use std::borrow::Borrow;
 use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector2};
 
 use crate::batch::{PairBlock, PassTerms, Scan};
-use crate::cell::{Gaussian, DEFAULT_SIGMA_FLOOR};
+use crate::cell::DEFAULT_SIGMA_FLOOR;
 use crate::degeneracy::{constrained_projector, unconstrained_directions};
-use crate::distributions::{DistOptions, Distributions};
+use crate::distributions::{CursorVisitor, DistLookup, DistOptions, Distributions};
 use crate::error::{check_bound, check_finite, NdtError, Result};
 use crate::grid::{check_points, NdtGrid};
 use crate::information::{own_cell_pairs, point_to_plane_information};
@@ -19,7 +20,6 @@ use crate::reduce::voxel_runs;
 use crate::score::{Order, ScoreTerms};
 use crate::se2::Pose2;
 use crate::solver::{covariance_from_hessian, minimise, SolverOptions};
-use crate::table::Cursor;
 
 /// Largest admissible neighbour-search radius \[cells\].
 pub const MAX_SEARCH_RADIUS: u32 = 1000;
@@ -314,12 +314,12 @@ pub struct MatchResult {
 /// The distribution a map-frame point is paired with: its own cell's
 /// (`true`), else (with neighbour search) the nearest one found ring by ring.
 #[inline]
-fn pair<'a>(
-    cursor: &mut Cursor<'a, Gaussian>,
+fn pair<L: DistLookup>(
+    cursor: &mut L,
     xw: Vector2<f64>,
     inv_cell: f64,
     options: &MatchOptions,
-) -> Option<(&'a Gaussian, bool)> {
+) -> Option<(L::Dist, bool)> {
     let key = CellKey::of(xw, inv_cell)?;
     match cursor.get(key) {
         Some(g) => Some((g, true)),
@@ -376,38 +376,71 @@ fn evaluate_serial(
     options: &MatchOptions,
     order: Order,
 ) -> PassTerms {
-    let sin_cos = pose.theta.sin_cos();
-    let scan = Scan { sin_cos, order };
-    let mut matched = 0;
-    let mut block = PairBlock::default();
-    let mut cursor = dists.cursor();
-    for (i, p) in points.iter().enumerate() {
-        let w = weights.and_then(|w| w.get(i)).copied().unwrap_or(1.0);
-        let xw = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
-        if options.pair_neighbors {
-            let Some(key) = CellKey::of(xw, inv_cell) else {
-                continue;
-            };
-            let mut any = false;
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    if let Some(g) = cursor.get(key.offset(dx, dy)) {
-                        block.push(*p, w, xw, g, dx == 0 && dy == 0, &scan);
-                        any = true;
+    dists.visit(Evaluation {
+        points,
+        weights,
+        pose,
+        inv_cell,
+        options,
+        order,
+    })
+}
+
+/// The arguments of [`evaluate_serial`], run with the distributions' reader
+/// of whichever kind (see [`Distributions::visit`]).
+struct Evaluation<'a> {
+    points: &'a [[f64; 2]],
+    weights: Option<&'a [f64]>,
+    pose: Pose2,
+    inv_cell: f64,
+    options: &'a MatchOptions,
+    order: Order,
+}
+
+impl CursorVisitor for Evaluation<'_> {
+    type Out = PassTerms;
+
+    fn visit<L: DistLookup>(self, mut cursor: L) -> PassTerms {
+        let Self {
+            points,
+            weights,
+            pose,
+            inv_cell,
+            options,
+            order,
+        } = self;
+        let sin_cos = pose.theta.sin_cos();
+        let scan = Scan { sin_cos, order };
+        let mut matched = 0;
+        let mut block = PairBlock::default();
+        for (i, p) in points.iter().enumerate() {
+            let w = weights.and_then(|w| w.get(i)).copied().unwrap_or(1.0);
+            let xw = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
+            if options.pair_neighbors {
+                let Some(key) = CellKey::of(xw, inv_cell) else {
+                    continue;
+                };
+                let mut any = false;
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        if let Some(g) = cursor.get(key.offset(dx, dy)) {
+                            block.push(*p, w, xw, g.borrow(), dx == 0 && dy == 0, &scan);
+                            any = true;
+                        }
                     }
                 }
+                if any {
+                    matched += 1;
+                    continue;
+                }
             }
-            if any {
+            if let Some((g, own)) = pair(&mut cursor, xw, inv_cell, options) {
+                block.push(*p, w, xw, g.borrow(), own, &scan);
                 matched += 1;
-                continue;
             }
         }
-        if let Some((g, own)) = pair(&mut cursor, xw, inv_cell, options) {
-            block.push(*p, w, xw, g, own, &scan);
-            matched += 1;
-        }
+        block.finish(&scan, matched)
     }
-    block.finish(&scan, matched)
 }
 
 /// Score terms of (weighted) points at `pose` summed over the pyramid levels

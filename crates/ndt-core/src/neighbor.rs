@@ -4,9 +4,10 @@
 use nalgebra::Vector2;
 
 use crate::cell::Gaussian;
-use crate::distributions::Distributions;
+use std::borrow::Borrow;
+
+use crate::distributions::{DistLookup, Distributions};
 use crate::key::CellKey;
-use crate::table::Cursor;
 
 /// Pairing rule: search the square rings at Chebyshev distance 1, 2, …,
 /// `radius` (in cells) around the point's own cell; in the first ring that
@@ -17,25 +18,25 @@ pub fn nearest_in_rings(
     point: Vector2<f64>,
     key: CellKey,
     radius: u32,
-) -> Option<&Gaussian> {
+) -> Option<Gaussian> {
     nearest_in_rings_with(&mut dists.cursor(), point, key, radius)
 }
 
 /// [`nearest_in_rings`] through a cursor (the matcher's hot path: the rings
 /// mostly lie in the tile of the point's own cell).
 #[inline]
-pub fn nearest_in_rings_with<'a>(
-    cursor: &mut Cursor<'a, Gaussian>,
+pub fn nearest_in_rings_with<L: DistLookup>(
+    cursor: &mut L,
     point: Vector2<f64>,
     key: CellKey,
     radius: u32,
-) -> Option<&'a Gaussian> {
+) -> Option<L::Dist> {
     let radius = i32::try_from(radius).unwrap_or(i32::MAX);
     for r in 1..=radius {
-        let mut best: Option<(f64, &Gaussian)> = None;
+        let mut best: Option<(f64, L::Dist)> = None;
         let mut consider = |dx: i32, dy: i32| {
             if let Some(g) = cursor.get(key.offset(dx, dy)) {
-                let d2 = (g.mean - point).norm_squared();
+                let d2 = (g.borrow().mean - point).norm_squared();
                 if best.is_none_or(|(b, _)| d2 < b) {
                     best = Some((d2, g));
                 }

@@ -23,13 +23,6 @@ const EMPTY: u32 = u32::MAX;
 
 type Tile = [u32; (TILE * TILE) as usize];
 
-/// A value starting on a cache line: a [`crate::cell::Gaussian`] is 64 bytes,
-/// so each one takes exactly one line and a look-up touches one line, not
-/// two (with the key beside it, three in four values straddled a boundary).
-#[derive(Debug, Clone, Copy)]
-#[repr(align(64))]
-struct Line<T>(T);
-
 /// Tile index and slot within the tile of `key`.
 #[inline]
 fn split(key: CellKey) -> ((i32, i32), usize) {
@@ -62,8 +55,10 @@ pub struct CellTable<T> {
     /// Occupied tile slots per tile, so empty tiles can be reused.
     used: Vec<u32>,
     free_tiles: Vec<u32>,
-    /// The values, contiguous, and beside them (same index) their keys.
-    values: Vec<Line<T>>,
+    /// The values, contiguous, and beside them (same index) their keys. A
+    /// value type that should start on a cache line says so by its own
+    /// alignment (the matcher's distributions do).
+    values: Vec<T>,
     keys: Vec<CellKey>,
     /// The tile of the last insert (runs of inserts in one tile skip the hash).
     last_insert: Option<((i32, i32), u32)>,
@@ -139,12 +134,43 @@ impl<T> CellTable<T> {
         if i == EMPTY {
             None
         } else {
-            Some(&self.values[i as usize].0)
+            Some(&self.values[i as usize])
         }
     }
 
     /// Sets the value of `key` (replacing any).
     pub fn insert(&mut self, key: CellKey, value: T) {
+        let (t, slot) = self.place(key);
+        let i = &mut self.slots[t as usize][slot];
+        if *i == EMPTY {
+            *i = self.values.len() as u32;
+            self.values.push(value);
+            self.keys.push(key);
+            self.used[t as usize] += 1;
+        } else {
+            self.values[*i as usize] = value;
+        }
+    }
+
+    /// Sets the value of `key`, returning the one it replaces (one look-up
+    /// for both).
+    pub fn replace(&mut self, key: CellKey, value: T) -> Option<T> {
+        let (t, slot) = self.place(key);
+        let i = &mut self.slots[t as usize][slot];
+        if *i == EMPTY {
+            *i = self.values.len() as u32;
+            self.values.push(value);
+            self.keys.push(key);
+            self.used[t as usize] += 1;
+            None
+        } else {
+            Some(std::mem::replace(&mut self.values[*i as usize], value))
+        }
+    }
+
+    /// The tile of `key` (created when missing) and the cell's slot in it.
+    #[inline]
+    fn place(&mut self, key: CellKey) -> (u32, usize) {
         let (tile, slot) = split(key);
         let cached = self.last_insert.filter(|&(k, _)| k == tile).map(|(_, t)| t);
         let t = match cached.or_else(|| self.tiles.get(&tile).copied()) {
@@ -163,15 +189,7 @@ impl<T> CellTable<T> {
             }
         };
         self.last_insert = Some((tile, t));
-        let i = &mut self.slots[t as usize][slot];
-        if *i == EMPTY {
-            *i = self.values.len() as u32;
-            self.values.push(Line(value));
-            self.keys.push(key);
-            self.used[t as usize] += 1;
-        } else {
-            self.values[*i as usize] = Line(value);
-        }
+        (t, slot)
     }
 
     /// Removes the value of `key`, if any.
@@ -204,13 +222,13 @@ impl<T> CellTable<T> {
 
     /// Every `(key, value)`, in no particular order.
     pub fn iter(&self) -> impl Iterator<Item = (CellKey, &T)> {
-        self.keys.iter().zip(&self.values).map(|(k, v)| (*k, &v.0))
+        self.keys.iter().zip(&self.values).map(|(k, v)| (*k, v))
     }
 
     /// Bytes this table holds on the heap (capacity, not length): the values,
     /// the tiles and the tile index.
     pub fn heap_bytes(&self) -> usize {
-        self.values.capacity() * std::mem::size_of::<Line<T>>()
+        self.values.capacity() * std::mem::size_of::<T>()
             + self.keys.capacity() * std::mem::size_of::<CellKey>()
             + self.slots.capacity() * std::mem::size_of::<Tile>()
             + self.used.capacity() * 4
