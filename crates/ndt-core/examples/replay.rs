@@ -1,0 +1,107 @@
+//! Profiling harness: a log's scans from a dump of `benches/dump_scans.py`.
+//!
+//! `replay <dump> odometry [reps]`: `Odometry` (default configuration) over
+//! every scan, `reps` times; prints the time per scan and the last pose.
+//! `replay <dump> matchhash`: the first 3000 scans matched with the default
+//! options against a map that takes every third scan and loses every 17th
+//! cell every 50 scans; prints a hash of every pose's and score's bits, so
+//! two builds can be compared for bit-identical results.
+
+use std::error::Error;
+use std::time::Instant;
+
+use ndt_core::odometry::{Odometry, OdometryConfig};
+use ndt_core::{points_from_ranges, MatchOptions, NdtGrid, Pose2};
+
+type Scan = (Vec<f64>, Vec<f64>, Option<Pose2>);
+
+fn read_dump(path: &str) -> Result<Vec<Scan>, Box<dyn Error>> {
+    let buf = std::fs::read(path)?;
+    let mut words = buf
+        .chunks_exact(8)
+        .map(|c| <[u8; 8]>::try_from(c).map_err(|e| e.to_string()));
+    let mut next =
+        || -> Result<[u8; 8], Box<dyn Error>> { Ok(words.next().ok_or("truncated dump")??) };
+    let mut scans = Vec::new();
+    while scans.len() * 8 < buf.len() {
+        let Ok(n) = next().map(i64::from_le_bytes) else {
+            break;
+        };
+        let mut floats = |k: usize| -> Result<Vec<f64>, Box<dyn Error>> {
+            (0..k).map(|_| next().map(f64::from_le_bytes)).collect()
+        };
+        let ranges = floats(n as usize)?;
+        let angles = floats(n as usize)?;
+        let o = floats(3)?;
+        let odom = (!o[0].is_nan()).then(|| Pose2::new(o[0], o[1], o[2]));
+        scans.push((ranges, angles, odom));
+    }
+    Ok(scans)
+}
+
+fn odometry(scans: &[Scan], reps: usize) -> Result<(), Box<dyn Error>> {
+    for _ in 0..reps {
+        let mut odo = Odometry::new(OdometryConfig::default())?;
+        let t = Instant::now();
+        for (r, a, o) in scans {
+            odo.step(r, a, *o)?;
+        }
+        let s = t.elapsed().as_secs_f64();
+        let last = odo.poses().last().copied().unwrap_or_default();
+        println!(
+            "{} scans {s:.3} s {:.4} ms/scan, {} inserted, last pose {:.12} {:.12} {:.12}",
+            scans.len(),
+            1e3 * s / scans.len() as f64,
+            odo.insertions(),
+            last.x,
+            last.y,
+            last.theta
+        );
+    }
+    Ok(())
+}
+
+fn matchhash(scans: &[Scan]) -> Result<(), Box<dyn Error>> {
+    let options = MatchOptions::default();
+    let mut grid = NdtGrid::new(0.02)?;
+    let mut hash: u64 = 0;
+    let mut pose = scans.first().and_then(|s| s.2).unwrap_or_default();
+    let t = Instant::now();
+    for (i, (r, a, o)) in scans.iter().take(3000).enumerate() {
+        let points = points_from_ranges(r, a, 0.0, 30.0)?;
+        if !grid.is_empty() {
+            let step = match (scans[i - 1].2, *o) {
+                (Some(prev), Some(now)) => prev.between(now),
+                _ => Pose2::identity(),
+            };
+            let res = grid.match_scan(&points, pose.compose(step), &options)?;
+            for v in res.pose.to_array().into_iter().chain([res.score]) {
+                hash = hash.rotate_left(5) ^ v.to_bits();
+            }
+            pose = res.pose;
+        }
+        if i % 3 == 0 {
+            grid.insert(&points, pose)?;
+        }
+        if i % 50 == 0 {
+            let keys: Vec<_> = grid.keys().step_by(17).collect();
+            grid.remove_cells(&keys);
+        }
+    }
+    println!("hash {hash:016x} in {:.3} s", t.elapsed().as_secs_f64());
+    Ok(())
+}
+
+fn main() -> Result<(), Box<dyn Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let usage = "usage: replay <dump> odometry [reps] | replay <dump> matchhash";
+    let (Some(path), Some(mode)) = (args.get(1), args.get(2)) else {
+        return Err(usage.into());
+    };
+    let scans = read_dump(path)?;
+    match mode.as_str() {
+        "odometry" => odometry(&scans, args.get(3).map_or(Ok(1), |s| s.parse())?),
+        "matchhash" => matchhash(&scans),
+        _ => Err(usage.into()),
+    }
+}
