@@ -401,19 +401,16 @@ impl CursorVisitor for Evaluation<'_> {
     type Out = PassTerms;
 
     fn visit<L: DistLookup>(self, mut cursor: L) -> PassTerms {
-        let Self {
-            points,
-            weights,
-            pose,
-            inv_cell,
-            options,
-            order,
-        } = self;
+        let (pose, inv_cell, options, weights) =
+            (self.pose, self.inv_cell, self.options, self.weights);
         let sin_cos = pose.theta.sin_cos();
-        let scan = Scan { sin_cos, order };
+        let scan = Scan {
+            sin_cos,
+            order: self.order,
+        };
         let mut matched = 0;
         let mut block = PairBlock::default();
-        for (i, p) in points.iter().enumerate() {
+        for (i, p) in self.points.iter().enumerate() {
             let w = weights.and_then(|w| w.get(i)).copied().unwrap_or(1.0);
             let xw = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
             if options.pair_neighbors {

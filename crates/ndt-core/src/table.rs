@@ -140,16 +140,7 @@ impl<T> CellTable<T> {
 
     /// Sets the value of `key` (replacing any).
     pub fn insert(&mut self, key: CellKey, value: T) {
-        let (t, slot) = self.place(key);
-        let i = &mut self.slots[t as usize][slot];
-        if *i == EMPTY {
-            *i = self.values.len() as u32;
-            self.values.push(value);
-            self.keys.push(key);
-            self.used[t as usize] += 1;
-        } else {
-            self.values[*i as usize] = value;
-        }
+        let _ = self.replace(key, value);
     }
 
     /// Sets the value of `key`, returning the one it replaces (one look-up
