@@ -301,11 +301,12 @@ fn update_own(
     options: DistOptions,
     touched: &[CellKey],
 ) {
-    let rest = with_minority_neighbours(minority, options, touched, |_| true);
-    for key in rest {
+    for key in with_minority_neighbours(minority, options, touched, |_| true) {
         match own_distribution(cells, cell_size, options, key) {
             Some(g) => map.insert(key, Line(g)),
-            None => map.remove(key),
+            None => {
+                map.remove(key);
+            }
         }
     }
 }
@@ -378,44 +379,23 @@ fn update_shaped(
         changed: &changed,
         last: None,
     };
-    // The other touched cells: gone, a new mean under a shape, or a new
-    // distribution of their own without one (then with fusion their
-    // minority neighbours' too).
-    let mut own = Vec::new();
-    let mut own_seen = FxHashSet::default();
-    let mut reader = minority.reader();
+    // The other touched cells: gone, or a new mean under a shape.
     for &key in touched {
         match (cells.get(&key), kinds.of(store, ancestor_of(key))) {
             (None, _) => store.remove(key),
             (Some(stats), Some(Ancestor::Shaped(slot))) => {
-                if let Some(mean) = stats.mean() {
-                    store.set_shared(key, key.center(cell_size) + mean, slot);
-                }
+                set_shared(store, cell_size, key, stats, slot);
             }
-            (Some(_), Some(Ancestor::Unshaped)) => {
-                if own_seen.insert(key) {
-                    own.push(key);
-                }
-            }
-            (Some(_), Some(Ancestor::Blocked) | None) => {}
-        }
-        // A cell gone or changed changes its minority neighbours' fused sums.
-        if options.fuse_minority {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let n = key.offset(dx, dy);
-                    if (dx, dy) != (0, 0)
-                        && reader.contains(n)
-                        && kinds.of(store, ancestor_of(n)) == Some(Ancestor::Unshaped)
-                        && own_seen.insert(n)
-                    {
-                        own.push(n);
-                    }
-                }
-            }
+            _ => {}
         }
     }
-    for key in own {
+    // A new distribution of their own for those without a shape, and with
+    // fusion for their minority neighbours without one (a cell gone or
+    // changed changes its neighbours' fused sums).
+    let unshaped = with_minority_neighbours(minority, options, touched, |k| {
+        kinds.of(store, ancestor_of(k)) == Some(Ancestor::Unshaped)
+    });
+    for key in unshaped {
         store.set_own(key, own_distribution(cells, cell_size, options, key));
     }
 }
@@ -454,13 +434,17 @@ fn set_cell(
     own: &CellStats,
 ) {
     match store.ancestor(at) {
-        Ancestor::Shaped(slot) => {
-            if let Some(mean) = own.mean() {
-                store.set_shared(key, key.center(cell_size) + mean, slot);
-            }
-        }
+        Ancestor::Shaped(slot) => set_shared(store, cell_size, key, own, slot),
         Ancestor::Blocked => store.remove(key),
         Ancestor::Unshaped => store.set_own(key, own_distribution(cells, cell_size, options, key)),
+    }
+}
+
+/// Cell `key` (sums `own`) takes its own mean and the shared part `slot`
+/// (as [`Gaussian::from_shape`] gives it).
+fn set_shared(store: &mut ShapedStore, cell_size: f64, key: CellKey, own: &CellStats, slot: u32) {
+    if let Some(mean) = own.mean() {
+        store.set_shared(key, key.center(cell_size) + mean, slot);
     }
 }
 

@@ -1,11 +1,11 @@
 //! §IV-A(1) neighbour search: a point whose own cell has no distribution is
 //! paired with a nearby cell's, found ring by ring (Elias method).
 
+use std::borrow::Borrow;
+
 use nalgebra::Vector2;
 
 use crate::cell::Gaussian;
-use std::borrow::Borrow;
-
 use crate::distributions::{DistLookup, Distributions};
 use crate::key::CellKey;
 

@@ -166,11 +166,10 @@ impl ShapedStore {
 
     /// Cell `key` has no distribution.
     pub fn remove(&mut self, key: CellKey) {
-        if let Some(e) = self.cells.get(key) {
+        if let Some(e) = self.cells.remove(key) {
             if e.private {
                 self.free.push(e.part);
             }
-            self.cells.remove(key);
         }
     }
 

@@ -146,22 +146,6 @@ impl<T> CellTable<T> {
     /// Sets the value of `key`, returning the one it replaces (one look-up
     /// for both).
     pub fn replace(&mut self, key: CellKey, value: T) -> Option<T> {
-        let (t, slot) = self.place(key);
-        let i = &mut self.slots[t as usize][slot];
-        if *i == EMPTY {
-            *i = self.values.len() as u32;
-            self.values.push(value);
-            self.keys.push(key);
-            self.used[t as usize] += 1;
-            None
-        } else {
-            Some(std::mem::replace(&mut self.values[*i as usize], value))
-        }
-    }
-
-    /// The tile of `key` (created when missing) and the cell's slot in it.
-    #[inline]
-    fn place(&mut self, key: CellKey) -> (u32, usize) {
         let (tile, slot) = split(key);
         let cached = self.last_insert.filter(|&(k, _)| k == tile).map(|(_, t)| t);
         let t = match cached.or_else(|| self.tiles.get(&tile).copied()) {
@@ -180,18 +164,25 @@ impl<T> CellTable<T> {
             }
         };
         self.last_insert = Some((tile, t));
-        (t, slot)
+        let i = &mut self.slots[t as usize][slot];
+        if *i == EMPTY {
+            *i = self.values.len() as u32;
+            self.values.push(value);
+            self.keys.push(key);
+            self.used[t as usize] += 1;
+            None
+        } else {
+            Some(std::mem::replace(&mut self.values[*i as usize], value))
+        }
     }
 
-    /// Removes the value of `key`, if any.
-    pub fn remove(&mut self, key: CellKey) {
+    /// Removes the value of `key`, if any, and returns it.
+    pub fn remove(&mut self, key: CellKey) -> Option<T> {
         let (tile, slot) = split(key);
-        let Some(&t) = self.tiles.get(&tile) else {
-            return;
-        };
+        let t = *self.tiles.get(&tile)?;
         let i = self.slots[t as usize][slot];
         if i == EMPTY {
-            return;
+            return None;
         }
         self.slots[t as usize][slot] = EMPTY;
         self.used[t as usize] -= 1;
@@ -201,7 +192,7 @@ impl<T> CellTable<T> {
             self.free_tiles.push(t);
         }
         // Keep the values contiguous: move the last one into the hole.
-        self.values.swap_remove(i as usize);
+        let value = self.values.swap_remove(i as usize);
         self.keys.swap_remove(i as usize);
         if let Some(&moved) = self.keys.get(i as usize) {
             let (mt, ms) = split(moved);
@@ -209,6 +200,7 @@ impl<T> CellTable<T> {
                 self.slots[mt as usize][ms] = i;
             }
         }
+        Some(value)
     }
 
     /// Every `(key, value)`, in no particular order.
