@@ -99,6 +99,27 @@ def test_map_window_bounds_the_map() -> None:
     assert unbounded.grid().cell_size == 0.02 and len(unbounded.grid()) == len(unbounded)
 
 
+def test_background_mapper_gives_the_same_poses_and_mapper() -> None:
+    truth = trajectory(50)
+    runs = []
+    for background in (False, True):
+        config = ndtgrid.OdometryConfig(
+            map_window=4, insert_distance=0.02, background_mapper=background
+        )
+        odo = ndtgrid.Odometry(config=config)
+        snapshots = []
+        for k, pose in enumerate(truth):
+            r, a = polar(pose, seed=k, noise=0.01)
+            odo.step(r, a)
+            if k % 10 == 9:
+                snapshots.append(odo.mapper.to_bytes())
+        runs.append((odo.poses, snapshots, odo.mapper.removal_counts().as_dict()))
+    (p0, s0, c0), (p1, s1, c1) = runs
+    np.testing.assert_array_equal(p0, p1)
+    assert len(s0) == 5 and s0 == s1
+    assert c0 == c1 and sum(c0.values()) > 0
+
+
 def test_bad_input_is_rejected_and_leaves_the_loop_unchanged() -> None:
     odo = ndtgrid.Odometry()
     r, a = polar(np.zeros(3))

@@ -992,6 +992,7 @@ class OdometryLoop:
         observation_check: bool | None = None,
         radial_confirmation: bool | None = None,
         match_filtered_map: bool | None = None,
+        background_mapper: bool | None = None,
     ) -> None: ...
     def step(
         self, ranges: ArrayLike, angles: ArrayLike, odom: ArrayLike | None = None

@@ -120,6 +120,12 @@ class OdometryConfig:
         every filtered variant matched worse (MIT Killian: 0.067-0.084 m relation
         error against 0.048 m); the elimination serves the map people and planners
         use (:attr:`Odometry.mapper`).
+    background_mapper : bool, default True
+        Update the mapper on a helper thread behind the loop: matching goes on while
+        the §V elimination of the last inserted scan runs, and :attr:`Odometry.mapper`
+        waits for it. Poses and mapper are the same bit for bit either way; it uses a
+        second core (Intel log on 2 cores: BENCHMARK.md, "Speed"). Ignored with
+        ``match_filtered_map``.
     """
 
     min_range: float = 0.0
@@ -152,6 +158,7 @@ class OdometryConfig:
     observation_check: bool = True
     radial_confirmation: bool = True
     match_filtered_map: bool = False
+    background_mapper: bool = True
 
 
 class Odometry:

@@ -46,10 +46,13 @@ fn odometry(scans: &[Scan], reps: usize) -> Result<(), Box<dyn Error>> {
         for (r, a, o) in scans {
             odo.step(r, a, *o)?;
         }
+        // Wait for the mapper (behind the loop by default) to take in the
+        // last scans: part of the run.
+        let cells = odo.mapper().grid().len();
         let s = t.elapsed().as_secs_f64();
         let last = odo.poses().last().copied().unwrap_or_default();
         println!(
-            "{} scans {s:.3} s {:.4} ms/scan, {} inserted, last pose {:.12} {:.12} {:.12}",
+            "{} scans {s:.3} s {:.4} ms/scan, {} inserted, {cells} mapper cells, last pose {:.12} {:.12} {:.12}",
             scans.len(),
             1e3 * s / scans.len() as f64,
             odo.insertions(),

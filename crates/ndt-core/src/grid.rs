@@ -46,6 +46,13 @@ pub struct CellRecord {
     pub scatter: Matrix2<f64>,
 }
 
+/// A scan checked by [`NdtGrid::stage`]: its points in map coordinates
+/// with their finest-level cells.
+#[derive(Debug)]
+pub(crate) struct StagedScan {
+    points: Vec<(CellKey, Vector2<f64>)>,
+}
+
 /// A sparse, unbounded NDT grid map (§III-B).
 ///
 /// Memory grows with the mapped area (occupied cells), not with the number of
@@ -186,9 +193,16 @@ impl NdtGrid {
     ///
     /// Returns the keys of the cells that changed (each once, first-touch order).
     pub fn insert(&mut self, points: &[[f64; 2]], pose: Pose2) -> Result<Vec<CellKey>> {
+        let staged = self.stage(points, pose)?;
+        Ok(self.insert_staged(staged))
+    }
+
+    /// The checks of [`NdtGrid::insert`], without touching the grid: the
+    /// points in map coordinates with their cells, ready for
+    /// [`NdtGrid::insert_staged`] (which then cannot fail).
+    pub(crate) fn stage(&self, points: &[[f64; 2]], pose: Pose2) -> Result<StagedScan> {
         check_finite("pose", &pose.to_array())?;
         check_points("points", points)?;
-        // Validate everything before touching the map.
         let mut staged: Vec<(CellKey, Vector2<f64>)> = Vec::with_capacity(points.len());
         for (index, p) in points.iter().enumerate() {
             let w = pose.transform(Vector2::new(p[0], p[1]));
@@ -201,7 +215,14 @@ impl NdtGrid {
             })?;
             staged.push((key, w));
         }
-        let touched = self.pyramid.add(&staged);
+        Ok(StagedScan { points: staged })
+    }
+
+    /// Adds a scan staged by [`NdtGrid::stage`] on this grid: eq. (6) into
+    /// every pyramid level, then the prepared distributions of the touched
+    /// cells. Returns the touched finest-level keys (see [`NdtGrid::insert`]).
+    pub(crate) fn insert_staged(&mut self, staged: StagedScan) -> Vec<CellKey> {
+        let touched = self.pyramid.add(&staged.points);
         let prepared = self.prepared.get_mut().unwrap_or_else(|e| e.into_inner());
         for dist in prepared.iter_mut() {
             let l = dist.level();
@@ -210,7 +231,7 @@ impl NdtGrid {
                 Arc::make_mut(dist).update(level.cells(), level.cell_size(), keys, shape);
             }
         }
-        Ok(touched.into_iter().next().unwrap_or_default())
+        touched.into_iter().next().unwrap_or_default()
     }
 
     /// Removes the cells `keys` (their eq. (6) sums entirely) from the grid,

@@ -23,6 +23,7 @@ use crate::error::{check_bound, check_finite, NdtError, Result};
 use crate::grid::NdtGrid;
 use crate::key::CellKey;
 use crate::mapper::{Mapper, MapperOptions};
+use crate::mapworker::{MapperHost, MapperView};
 use crate::matcher::{MatchOptions, MatchResult};
 use crate::ranges::points_from_ranges;
 use crate::se2::Pose2;
@@ -103,6 +104,16 @@ pub struct OdometryConfig {
     /// BENCHMARK.md); the elimination is meant for the map people and
     /// planners use, which the mapper still provides.
     pub match_filtered_map: bool,
+    /// Update the mapper ([`Odometry::mapper`]) on a helper thread, behind
+    /// the loop, instead of in line (see [`crate::mapworker`]): the loop goes
+    /// on matching while the §V elimination of the last inserted scan runs,
+    /// and reading the mapper waits for it. The poses and the mapper are the
+    /// same bit for bit either way. On by default: it takes one more core
+    /// (the helper sleeps when idle) and the Intel log runs in less time on
+    /// 2 cores (BENCHMARK.md, "Speed"). Ignored with
+    /// [`OdometryConfig::match_filtered_map`] (the loop then matches against
+    /// the mapper's grid, so it must be up to date).
+    pub background_mapper: bool,
 }
 
 impl Default for OdometryConfig {
@@ -131,6 +142,7 @@ impl Default for OdometryConfig {
                 ..MapperOptions::default()
             },
             match_filtered_map: false,
+            background_mapper: true,
         }
     }
 }
@@ -221,7 +233,7 @@ pub struct StepOutcome {
 pub struct Odometry {
     config: OdometryConfig,
     grid: NdtGrid,
-    mapper: Mapper,
+    mapper: MapperHost,
     poses: Vec<Pose2>,
     last_odom: Option<Pose2>,
     last_insert: Option<Pose2>,
@@ -243,7 +255,10 @@ impl Odometry {
         };
         Ok(Self {
             grid: NdtGrid::new(config.cell_size)?,
-            mapper: Mapper::new(config.cell_size, mapper_options)?,
+            mapper: MapperHost::new(
+                Mapper::new(config.cell_size, mapper_options)?,
+                config.background_mapper && !config.match_filtered_map,
+            )?,
             config,
             poses: Vec::new(),
             last_odom: None,
@@ -262,17 +277,20 @@ impl Odometry {
     /// The map the scans are matched against: every inserted point, or the
     /// mapper's filtered grid with [`OdometryConfig::match_filtered_map`].
     pub fn grid(&self) -> &NdtGrid {
-        if self.config.match_filtered_map {
-            self.mapper.grid()
-        } else {
-            &self.grid
+        match self.mapper.inline() {
+            // The filtered map's mapper is always in line (see
+            // `OdometryConfig::background_mapper`).
+            Some(m) if self.config.match_filtered_map => m.grid(),
+            _ => &self.grid,
         }
     }
 
     /// The mapper (grid and §V filter) the loop builds: the map to show and
-    /// navigate with.
-    pub fn mapper(&self) -> &Mapper {
-        &self.mapper
+    /// navigate with. With [`OdometryConfig::background_mapper`] this waits
+    /// until the helper has taken in every inserted scan, and the helper
+    /// waits while the view is held.
+    pub fn mapper(&self) -> MapperView<'_> {
+        self.mapper.view()
     }
 
     /// The pose of every scan so far, in order.
@@ -427,24 +445,28 @@ impl Odometry {
     pub fn update_map(&mut self, ranges: &[f64], angles: &[f64], pose: Pose2) -> Result<()> {
         let points = self.valid_points(ranges, angles)?;
         check_finite("pose", &pose.to_array())?;
-        // The mapper validates first (beams, pose, cell indices); the matching
-        // grid's insert then cannot fail for the same points, pose and cells.
-        self.mapper.insert_scan(ranges, angles, pose)?;
-        // The cells this scan touched (the filter stores a subset of them),
-        // each once: the matching grid's insert lists them.
-        let touched = if self.config.match_filtered_map {
+        if self.config.match_filtered_map {
+            self.mapper.insert_scan(ranges, angles, pose)?;
+            // The cells this scan touched (the filter stores a subset of
+            // them), each once.
             let inv = 1.0 / self.config.cell_size;
             let mut seen = rustc_hash::FxHashSet::default();
-            points
+            let touched = points
                 .iter()
                 .filter_map(|p| {
                     CellKey::of(pose.transform(nalgebra::Vector2::new(p[0], p[1])), inv)
                 })
                 .filter(|k| seen.insert(*k))
-                .collect()
-        } else {
-            self.grid.insert(&points, pose)?
-        };
+                .collect();
+            self.record_insertion(touched, pose);
+            return Ok(());
+        }
+        // Both maps check the scan before either changes (the mapper's
+        // insertion, queued or not, then cannot fail).
+        self.mapper.check_scan(ranges, angles, pose)?;
+        let staged = self.grid.stage(&points, pose)?;
+        self.mapper.insert_scan(ranges, angles, pose)?;
+        let touched = self.grid.insert_staged(staged);
         self.record_insertion(touched, pose);
         Ok(())
     }
@@ -479,7 +501,7 @@ impl Odometry {
                 }
             }
         }
-        self.mapper.remove_cells(&stale);
         self.grid.remove_cells(&stale);
+        self.mapper.remove_cells(stale);
     }
 }

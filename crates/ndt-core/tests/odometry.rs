@@ -98,3 +98,45 @@ fn bad_input_leaves_the_loop_unchanged() {
     };
     assert!(Odometry::new(config).is_err());
 }
+
+#[test]
+fn mapper_behind_the_loop_equals_the_mapper_in_line() {
+    let run = |background_mapper: bool| {
+        let config = OdometryConfig {
+            map_window: 3,
+            insert_distance: 0.03,
+            background_mapper,
+            ..OdometryConfig::default()
+        };
+        let mut odo = Odometry::new(config).unwrap();
+        let mut snapshots = Vec::new();
+        let mut copy = None;
+        for i in 0..30 {
+            let t = f64::from(i);
+            let truth = Pose2::new(0.02 * t, 0.01 * t, 0.01 * t);
+            let (r, a) = square_scan(truth, 361);
+            odo.step(&r, &a, None).unwrap();
+            // Bad input is refused before the queued mapper changes.
+            assert!(odo.update_map(&r, &a[1..], truth).is_err());
+            if i % 7 == 0 {
+                snapshots.push(odo.mapper().to_bytes().unwrap());
+            }
+            if i == 12 {
+                copy = Some(odo.clone());
+            }
+        }
+        // A clone taken mid-run goes on by itself, from the same mapper.
+        let mut copy = copy.unwrap();
+        let (r, a) = square_scan(Pose2::new(0.3, 0.1, 0.1), 361);
+        copy.update_map(&r, &a, Pose2::new(0.3, 0.1, 0.1)).unwrap();
+        snapshots.push(copy.mapper().to_bytes().unwrap());
+        snapshots.push(odo.mapper().to_bytes().unwrap());
+        let counts = odo.mapper().removal_counts();
+        (odo.poses().to_vec(), snapshots, counts)
+    };
+    let (inline, behind) = (run(false), run(true));
+    assert!(inline.1.len() == 7 && inline.1.iter().all(|b| !b.is_empty()));
+    assert_eq!(inline.0, behind.0);
+    assert_eq!(inline.1, behind.1);
+    assert_eq!(inline.2, behind.2);
+}

@@ -110,7 +110,8 @@ impl PyOdometry {
         max_iterations = None, max_step_cells = None, max_step_rotation = None,
         levels = None, coarse_rotation_search = None, freeze_unconstrained = None, freeze_ratio = None, coarse_model = None,
         outlier_filter = None, edge_removal = None, backshift_rejection = None,
-        observation_check = None, radial_confirmation = None, match_filtered_map = None
+        observation_check = None, radial_confirmation = None, match_filtered_map = None,
+        background_mapper = None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -145,6 +146,7 @@ impl PyOdometry {
         observation_check: Option<bool>,
         radial_confirmation: Option<bool>,
         match_filtered_map: Option<bool>,
+        background_mapper: Option<bool>,
     ) -> PyResult<Self> {
         let d = OdometryConfig::default();
         let m = d.matcher;
@@ -200,6 +202,7 @@ impl PyOdometry {
                 ..d.mapper
             },
             match_filtered_map: match_filtered_map.unwrap_or(d.match_filtered_map),
+            background_mapper: background_mapper.unwrap_or(d.background_mapper),
         };
         Ok(Self {
             inner: Mutex::new(Odometry::new(config).map_err(to_py)?),
@@ -303,6 +306,7 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("observation_check", c.mapper.observation_check)?;
     out.set_item("radial_confirmation", c.mapper.radial_confirmation)?;
     out.set_item("match_filtered_map", c.match_filtered_map)?;
+    out.set_item("background_mapper", c.background_mapper)?;
     Ok(out)
 }
 

@@ -160,6 +160,12 @@ impl Mapper {
             .insert_scan(&mut self.grid, ranges, angles, pose)
     }
 
+    /// Whether [`Mapper::insert_scan`] would accept this scan (it changes
+    /// nothing; see [`MapFilter::check_scan`]).
+    pub(crate) fn check_scan(&self, ranges: &[f64], angles: &[f64], pose: Pose2) -> Result<()> {
+        self.filter.check_scan(&self.grid, ranges, angles, pose)
+    }
+
     /// The map matched against.
     pub fn grid(&self) -> &NdtGrid {
         &self.grid

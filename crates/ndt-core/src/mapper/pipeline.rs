@@ -184,6 +184,19 @@ impl MapFilter {
         Ok(())
     }
 
+    /// The checks of [`MapFilter::insert_scan`] alone: `Ok` means the same
+    /// call would not fail (its only failures are these checks and the
+    /// grid's, on the same beams).
+    pub(crate) fn check_scan(
+        &self,
+        grid: &NdtGrid,
+        ranges: &[f64],
+        angles: &[f64],
+        pose: Pose2,
+    ) -> Result<()> {
+        self.valid_beams(grid, ranges, angles, pose).map(drop)
+    }
+
     /// The valid beams of a scan, checked: lengths, finite angles and pose,
     /// cell indices in range.
     fn valid_beams(
