@@ -445,44 +445,44 @@ impl Odometry {
     pub fn update_map(&mut self, ranges: &[f64], angles: &[f64], pose: Pose2) -> Result<()> {
         let points = self.valid_points(ranges, angles)?;
         check_finite("pose", &pose.to_array())?;
-        if self.config.match_filtered_map {
-            self.mapper.insert_scan(ranges, angles, pose)?;
+        // Both maps check the scan before either changes; then neither
+        // insertion can fail (the mapper's only failures are its checks and
+        // its grid's, on the same beams).
+        self.mapper.check_scan(ranges, angles, pose)?;
+        let touched = if self.config.match_filtered_map {
             // The cells this scan touched (the filter stores a subset of
             // them), each once.
             let inv = 1.0 / self.config.cell_size;
             let mut seen = rustc_hash::FxHashSet::default();
-            let touched = points
+            points
                 .iter()
                 .filter_map(|p| {
                     CellKey::of(pose.transform(nalgebra::Vector2::new(p[0], p[1])), inv)
                 })
                 .filter(|k| seen.insert(*k))
-                .collect();
-            self.record_insertion(touched, pose);
-            return Ok(());
-        }
-        // Both maps check the scan before either changes (the mapper's
-        // insertion, queued or not, then cannot fail).
-        self.mapper.check_scan(ranges, angles, pose)?;
-        let staged = self.grid.stage(&points, pose)?;
-        self.mapper.insert_scan(ranges, angles, pose)?;
-        let touched = self.grid.insert_staged(staged);
-        self.record_insertion(touched, pose);
-        Ok(())
+                .collect()
+        } else {
+            let staged = self.grid.stage(&points, pose)?;
+            self.grid.insert_staged(staged)
+        };
+        let stale = self.record_insertion(touched, pose);
+        // The mapper takes the scan, then loses the same stale cells: in
+        // line, or queued behind the loop as one job.
+        self.mapper.update(ranges, angles, pose, stale)
     }
 
     fn valid_points(&self, ranges: &[f64], angles: &[f64]) -> Result<Vec<[f64; 2]>> {
         points_from_ranges(ranges, angles, self.config.min_range, self.config.max_range)
     }
 
-    /// The memory bound: forget cells no scan of the last `map_window`
-    /// insertions touched.
-    fn record_insertion(&mut self, touched: Vec<CellKey>, pose: Pose2) {
+    /// The memory bound: the matching grid forgets the cells no scan of the
+    /// last `map_window` insertions touched; returns them for the mapper.
+    fn record_insertion(&mut self, touched: Vec<CellKey>, pose: Pose2) -> Vec<CellKey> {
         self.insertions += 1;
         self.last_insert = Some(pose);
         let window = self.config.map_window;
         if window == 0 {
-            return;
+            return Vec::new();
         }
         let n = self.insertions;
         for &key in &touched {
@@ -502,6 +502,6 @@ impl Odometry {
             }
         }
         self.grid.remove_cells(&stale);
-        self.mapper.remove_cells(stale);
+        stale
     }
 }

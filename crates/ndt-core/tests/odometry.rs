@@ -119,7 +119,10 @@ fn mapper_behind_the_loop_equals_the_mapper_in_line() {
             // Bad input is refused before the queued mapper changes.
             assert!(odo.update_map(&r, &a[1..], truth).is_err());
             if i % 7 == 0 {
-                snapshots.push(odo.mapper().to_bytes().unwrap());
+                // Views nest (also on one thread) and agree.
+                let (first, second) = (odo.mapper(), odo.mapper());
+                assert_eq!(first.grid().len(), second.grid().len());
+                snapshots.push(first.to_bytes().unwrap());
             }
             if i == 12 {
                 copy = Some(odo.clone());
