@@ -135,10 +135,14 @@ impl Distributions {
         shape: Option<Shape<'_>>,
     ) {
         if self.options.fuse_minority {
-            for &key in touched {
-                let minority = cells.get(&key).is_some_and(|s| s.count < MIN_POINTS);
-                self.minority.set(key, minority);
-            }
+            // In and out of the mask by runs (one look-up per run of keys
+            // in one word; each key is touched once, so the order of the
+            // two passes does not matter).
+            let (ins, outs): (Vec<CellKey>, Vec<CellKey>) = touched
+                .iter()
+                .partition(|&&key| cells.get(&key).is_some_and(|s| s.count < MIN_POINTS));
+            self.minority.set_all(&ins, true);
+            self.minority.set_all(&outs, false);
         }
         let options = self.options;
         match (&mut self.store, shape) {
@@ -391,8 +395,21 @@ fn update_shaped(
     }
     // A new distribution of their own for those without a shape, and with
     // fusion for their minority neighbours without one (a cell gone or
-    // changed changes its neighbours' fused sums).
-    let unshaped = with_minority_neighbours(minority, options, touched, |k| {
+    // changed changes its neighbours' fused sums). A touched cell inside its
+    // ancestor (not on its border) has all 8 neighbours under the same
+    // ancestor, so when that one is not shapeless neither the cell nor a
+    // neighbour is wanted: such cells are left out of the search.
+    let side = 1i32 << depth;
+    let inside = |k: CellKey| {
+        let (x, y) = (k.ix & (side - 1), k.iy & (side - 1));
+        x > 0 && y > 0 && x < side - 1 && y < side - 1
+    };
+    let searched: Vec<CellKey> = touched
+        .iter()
+        .copied()
+        .filter(|&k| !inside(k) || kinds.of(store, ancestor_of(k)) == Some(Ancestor::Unshaped))
+        .collect();
+    let unshaped = with_minority_neighbours(minority, options, &searched, |k| {
         kinds.of(store, ancestor_of(k)) == Some(Ancestor::Unshaped)
     });
     for key in unshaped {

@@ -26,7 +26,7 @@ use crate::se2::Pose2;
 /// Scans the loop collects before handing them to the helper at once: each
 /// hand-over wakes the helper, which costs the loop a system call (about
 /// 26 µs in a VM, measured by `perf` on the Intel log).
-const BATCH_LENGTH: usize = 4;
+const BATCH_LENGTH: usize = 8;
 
 /// Batches handed over before the loop waits for the helper (bounds its lag
 /// and the copies of scans it holds).

@@ -423,7 +423,7 @@ impl Odometry {
         }
         let inserted = !points.is_empty() && self.should_insert(pose);
         if inserted {
-            self.update_map(ranges, angles, pose)?;
+            self.insert_points(&points, ranges, angles, pose)?;
         }
         self.poses.push(pose);
         if odom.is_some() {
@@ -444,6 +444,18 @@ impl Odometry {
     /// the map is unchanged.
     pub fn update_map(&mut self, ranges: &[f64], angles: &[f64], pose: Pose2) -> Result<()> {
         let points = self.valid_points(ranges, angles)?;
+        self.insert_points(&points, ranges, angles, pose)
+    }
+
+    /// [`Odometry::update_map`] with the scan's valid points already taken
+    /// from `ranges` and `angles` (as [`Odometry::step`] has them).
+    fn insert_points(
+        &mut self,
+        points: &[[f64; 2]],
+        ranges: &[f64],
+        angles: &[f64],
+        pose: Pose2,
+    ) -> Result<()> {
         check_finite("pose", &pose.to_array())?;
         // Both maps check the scan before either changes; then neither
         // insertion can fail (the mapper's only failures are its checks and
@@ -462,7 +474,7 @@ impl Odometry {
                 .filter(|k| seen.insert(*k))
                 .collect()
         } else {
-            let staged = self.grid.stage(&points, pose)?;
+            let staged = self.grid.stage(points, pose)?;
             self.grid.insert_staged(staged)
         };
         let stale = self.record_insertion(touched, pose);

@@ -162,11 +162,15 @@ impl Pyramid {
             let below = touched_all[l - 1].len();
             let mut parents = FxHashSet::with_capacity_and_hasher(below, Default::default());
             let mut changed = Vec::with_capacity(below);
+            // Changed children come in runs under one parent: the last
+            // parent is not looked up again.
+            let mut last = None;
             for &child in &touched_all[l - 1] {
                 let parent = coarse_key(child, 1);
-                if parents.insert(parent) {
+                if last != Some(parent) && parents.insert(parent) {
                     changed.push(parent);
                 }
+                last = Some(parent);
             }
             let (below, above) = self.levels.split_at_mut(l);
             let (lower, upper) = (&below[l - 1], &mut above[0]);
