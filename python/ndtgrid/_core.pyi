@@ -1016,7 +1016,8 @@ class OdometryLoop:
     def grid(self) -> NdtGrid:
         """A copy of the map."""
     def mapper(self) -> Mapper:
-        """A copy of the mapper (grid and §V filter state)."""
+        """A copy of the mapper (grid and §V filter state), once a background mapper
+        has taken in every inserted scan."""
     def config(self) -> dict[str, Any]:
         """The settings in force, as keyword arguments (plus ``cell_size``)."""
 

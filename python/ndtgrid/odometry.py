@@ -292,7 +292,8 @@ class Odometry:
         """The :class:`~ndtgrid.Mapper` the loop builds (its grid and §V filter state).
 
         A copy as of this access: later steps do not change it, and changing it does
-        not change the loop.
+        not change the loop. With ``background_mapper`` (the default) this first waits
+        until the helper thread has taken in every inserted scan.
         """
         mapper: Mapper = self._loop.mapper()
         return mapper

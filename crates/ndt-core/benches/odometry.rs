@@ -4,7 +4,12 @@
 //!
 //! The loop first runs along a 60-scan path; each measured step then processes
 //! a later scan of the path (the first whose step inserts it) from a clone of
-//! that loop.
+//! that loop. `181_beams_2cm` updates the mapper in line (the whole step on
+//! one thread, `background_mapper: false`); `181_beams_2cm_mapper_behind` has
+//! the default helper thread and also reads the mapper, which waits for the
+//! helper to take the scan in: one isolated step cannot overlap the two, so
+//! this is the step's latency with the hand-over, not the loop's throughput
+//! (for that, the whole Intel log: `examples/replay.rs`, `benches/speed.py`).
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -31,7 +36,26 @@ fn path(k: u32) -> Pose2 {
 }
 
 fn bench_step(c: &mut Criterion) {
-    let mut odo = Odometry::new(OdometryConfig::default()).unwrap_or_else(|e| panic!("{e}"));
+    let mut group = c.benchmark_group("odometry_step");
+    for (name, background_mapper) in [
+        ("181_beams_2cm", false),
+        ("181_beams_2cm_mapper_behind", true),
+    ] {
+        let config = OdometryConfig {
+            background_mapper,
+            ..OdometryConfig::default()
+        };
+        bench_step_with(&mut group, name, config);
+    }
+    group.finish();
+}
+
+fn bench_step_with(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    config: OdometryConfig,
+) {
+    let mut odo = Odometry::new(config).unwrap_or_else(|e| panic!("{e}"));
     for k in 0..60 {
         let (r, a) = polar(path(k), u64::from(k));
         let odom = path(k).compose(Pose2::new(0.0, 0.0, 0.002 * f64::from(k)));
@@ -62,16 +86,19 @@ fn bench_step(c: &mut Criterion) {
         k += 1;
     }
     let (r, a, odom) = scan(k);
-    let mut group = c.benchmark_group("odometry_step");
     group.throughput(Throughput::Elements(r.len() as u64));
-    group.bench_function("181_beams_2cm", |b| {
+    group.bench_function(name, |b| {
         b.iter_batched_ref(
             || odo.clone(),
-            |o| o.step(black_box(&r), black_box(&a), Some(odom)),
+            |o| {
+                let out = o.step(black_box(&r), black_box(&a), Some(odom));
+                // Waits for a mapper behind the loop (at once in line).
+                black_box(o.mapper().grid().len());
+                out
+            },
             BatchSize::LargeInput,
         )
     });
-    group.finish();
 }
 
 criterion_group!(benches, bench_step);

@@ -1,7 +1,8 @@
 //! Profiling harness: a log's scans from a dump of `benches/dump_scans.py`.
 //!
-//! `replay <dump> odometry [reps]`: `Odometry` (default configuration) over
-//! every scan, `reps` times; prints the time per scan and the last pose.
+//! `replay <dump> odometry [reps] [inline]`: `Odometry` (default
+//! configuration; `inline`: `background_mapper: false`) over every scan,
+//! `reps` times; prints the time per scan and the last pose.
 //! `replay <dump> matchhash`: the first 3000 scans matched with the default
 //! options against a map that takes every third scan and loses every 17th
 //! cell (in key order) every 50 scans; prints a hash of every pose's and
@@ -54,9 +55,13 @@ fn thread_cpu() -> f64 {
     ticks / 100.0
 }
 
-fn odometry(scans: &[Scan], reps: usize) -> Result<(), Box<dyn Error>> {
+fn odometry(scans: &[Scan], reps: usize, inline: bool) -> Result<(), Box<dyn Error>> {
+    let config = OdometryConfig {
+        background_mapper: !inline,
+        ..OdometryConfig::default()
+    };
     for _ in 0..reps {
-        let mut odo = Odometry::new(OdometryConfig::default())?;
+        let mut odo = Odometry::new(config)?;
         let t = Instant::now();
         let cpu = thread_cpu();
         for (r, a, o) in scans {
@@ -117,13 +122,17 @@ fn matchhash(scans: &[Scan]) -> Result<(), Box<dyn Error>> {
 
 fn main() -> Result<(), Box<dyn Error>> {
     let args: Vec<String> = std::env::args().collect();
-    let usage = "usage: replay <dump> odometry [reps] | replay <dump> matchhash";
+    let usage = "usage: replay <dump> odometry [reps] [inline] | replay <dump> matchhash";
     let (Some(path), Some(mode)) = (args.get(1), args.get(2)) else {
         return Err(usage.into());
     };
     let scans = read_dump(path)?;
     match mode.as_str() {
-        "odometry" => odometry(&scans, args.get(3).map_or(Ok(1), |s| s.parse())?),
+        "odometry" => odometry(
+            &scans,
+            args.get(3).map_or(Ok(1), |s| s.parse())?,
+            args.get(4).is_some_and(|s| s == "inline"),
+        ),
         "matchhash" => matchhash(&scans),
         _ => Err(usage.into()),
     }
