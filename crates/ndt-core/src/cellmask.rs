@@ -61,6 +61,49 @@ impl CellMask {
         }
     }
 
+    /// Puts each key of `keys` in the set or takes it out as `member` says:
+    /// one look-up per run of keys in one block.
+    pub fn set_each(&mut self, keys: &[CellKey], mut member: impl FnMut(CellKey) -> bool) {
+        // The current block with the bits to set and to clear in it.
+        let mut run: Option<((i32, i32), u64, u64)> = None;
+        for &key in keys {
+            let (block, bit) = split(key);
+            let (set, clear) = if member(key) {
+                (1 << bit, 0)
+            } else {
+                (0, 1 << bit)
+            };
+            match &mut run {
+                Some((b, s, c)) if *b == block => {
+                    *s |= set;
+                    *c |= clear;
+                }
+                _ => {
+                    if let Some((b, s, c)) = run.take() {
+                        self.update(b, s, c);
+                    }
+                    run = Some((block, set, clear));
+                }
+            }
+        }
+        if let Some((b, s, c)) = run {
+            self.update(b, s, c);
+        }
+    }
+
+    /// Sets the bits `set` and clears the bits `clear` of `block` (disjoint).
+    fn update(&mut self, block: (i32, i32), set: u64, clear: u64) {
+        if set != 0 {
+            let word = self.blocks.entry(block).or_insert(0);
+            *word = (*word | set) & !clear;
+        } else if let Some(word) = self.blocks.get_mut(&block) {
+            *word &= !clear;
+            if *word == 0 {
+                self.blocks.remove(&block);
+            }
+        }
+    }
+
     fn apply(&mut self, block: (i32, i32), bits: u64, member: bool) {
         if member {
             *self.blocks.entry(block).or_insert(0) |= bits;
@@ -163,6 +206,12 @@ mod tests {
         );
         assert_eq!(rebuilt, mask);
         assert_eq!(runs, mask);
+        // One pass in and out by runs gives the same mask.
+        let mut each = CellMask::of(keys.iter().copied());
+        each.set_each(&keys, |k| {
+            cells.get(&k).is_some_and(|s| s.count < MIN_POINTS)
+        });
+        assert_eq!(each, mask);
         let mut reader = mask.reader();
         for iy in -22..22 {
             for ix in -22..22 {

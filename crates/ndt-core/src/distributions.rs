@@ -10,6 +10,7 @@ use rustc_hash::{FxHashMap, FxHashSet};
 use crate::cell::{CellStats, Gaussian, MIN_POINTS};
 use crate::cellmask::CellMask;
 use crate::key::CellKey;
+use crate::scratch::KeyScratch;
 use crate::shape::Shape;
 use crate::shaped::{Ancestor, ShapedCursor, ShapedStore};
 use crate::table::{CellTable, Cursor};
@@ -42,6 +43,8 @@ pub struct Distributions {
     store: Store,
     /// The level's minority cells (with fusion; empty without).
     minority: CellMask,
+    /// The keys an update has met (reused between updates).
+    seen: KeyScratch,
 }
 
 /// A distribution starting on a cache line: a [`Gaussian`] is 64 bytes, so
@@ -110,6 +113,7 @@ impl Distributions {
             shape_depth: shape.map_or(0, |s| s.depth()),
             store,
             minority,
+            seen: KeyScratch::default(),
         }
     }
 
@@ -136,21 +140,22 @@ impl Distributions {
     ) {
         if self.options.fuse_minority {
             // In and out of the mask by runs (one look-up per run of keys
-            // in one word; each key is touched once, so the order of the
-            // two passes does not matter).
-            let (ins, outs): (Vec<CellKey>, Vec<CellKey>) = touched
-                .iter()
-                .partition(|&&key| cells.get(&key).is_some_and(|s| s.count < MIN_POINTS));
-            self.minority.set_all(&ins, true);
-            self.minority.set_all(&outs, false);
+            // in one word).
+            self.minority.set_each(touched, |key| {
+                cells.get(&key).is_some_and(|s| s.count < MIN_POINTS)
+            });
         }
         let options = self.options;
+        let search = Search {
+            minority: &self.minority,
+            seen: self.seen.take(),
+        };
         match (&mut self.store, shape) {
             (Store::Shaped(store), Some(s)) => {
-                update_shaped(store, &self.minority, cells, cell_size, options, touched, s);
+                update_shaped(store, search, cells, cell_size, options, touched, s);
             }
             (Store::Own(map), _) => {
-                update_own(map, &self.minority, cells, cell_size, options, touched);
+                update_own(map, search, cells, cell_size, options, touched);
             }
             // Built with a shape level, updated without one: cannot happen
             // (the grid passes the same depth); rebuild rather than go stale.
@@ -299,13 +304,13 @@ impl DistLookup for DistCursor<'_> {
 /// tile of the table).
 fn update_own(
     map: &mut CellTable<Line>,
-    minority: &CellMask,
+    search: Search<'_>,
     cells: &FxHashMap<CellKey, CellStats>,
     cell_size: f64,
     options: DistOptions,
     touched: &[CellKey],
 ) {
-    for key in with_minority_neighbours(minority, options, touched, |_| true) {
+    for key in with_minority_neighbours(search, options, touched, |_| true) {
         match own_distribution(cells, cell_size, options, key) {
             Some(g) => map.insert(key, Line(g)),
             None => {
@@ -315,17 +320,23 @@ fn update_own(
     }
 }
 
+/// What the minority-neighbour search of one update reads and keeps track
+/// of: the level's minority cells and the keys met so far (emptied).
+struct Search<'a> {
+    minority: &'a CellMask,
+    seen: &'a mut FxHashSet<CellKey>,
+}
+
 /// `touched`, and with fusion every minority neighbour of a touched cell
 /// (only those use fused sums that include it) for which `wanted` holds; each
 /// once, in the order met.
 fn with_minority_neighbours(
-    minority: &CellMask,
+    search: Search<'_>,
     options: DistOptions,
     touched: &[CellKey],
     mut wanted: impl FnMut(CellKey) -> bool,
 ) -> Vec<CellKey> {
-    let mut seen: FxHashSet<CellKey> =
-        FxHashSet::with_capacity_and_hasher(touched.len() * 2, Default::default());
+    let Search { minority, seen } = search;
     let mut rest = Vec::with_capacity(touched.len() * 2);
     let mut reader = minority.reader();
     for &key in touched {
@@ -349,7 +360,7 @@ fn with_minority_neighbours(
 /// [`Distributions::update`] with a shape level (see there).
 fn update_shaped(
     store: &mut ShapedStore,
-    minority: &CellMask,
+    search: Search<'_>,
     cells: &FxHashMap<CellKey, CellStats>,
     cell_size: f64,
     options: DistOptions,
@@ -409,7 +420,7 @@ fn update_shaped(
         .copied()
         .filter(|&k| !inside(k) || kinds.of(store, ancestor_of(k)) == Some(Ancestor::Unshaped))
         .collect();
-    let unshaped = with_minority_neighbours(minority, options, &searched, |k| {
+    let unshaped = with_minority_neighbours(search, options, &searched, |k| {
         kinds.of(store, ancestor_of(k)) == Some(Ancestor::Unshaped)
     });
     for key in unshaped {

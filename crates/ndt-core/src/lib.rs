@@ -43,6 +43,7 @@ pub mod quadratic;
 pub mod ranges;
 pub mod reduce;
 pub mod score;
+mod scratch;
 pub mod se2;
 pub mod shape;
 pub mod shaped;

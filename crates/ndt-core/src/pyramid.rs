@@ -4,11 +4,12 @@
 //! stored, and no level is ever rebuilt: every insert adds to all levels.
 
 use nalgebra::Vector2;
-use rustc_hash::{FxHashMap, FxHashSet};
+use rustc_hash::FxHashMap;
 
 use crate::cell::CellStats;
 use crate::cellmask::CellMask;
 use crate::key::{CellKey, KeyBounds};
+use crate::scratch::KeyScratch;
 
 /// Most levels a grid may have (fine level included).
 pub const MAX_LEVELS: usize = 12;
@@ -42,6 +43,8 @@ pub struct Pyramid {
     bounds: Option<KeyBounds>,
     /// The occupied fine cells, a bit each (see [`crate::cellmask`]).
     occupied: CellMask,
+    /// The keys an update has met (reused between updates).
+    seen: KeyScratch,
 }
 
 /// The key of the level-`level` cell covering fine cell `key`: an arithmetic
@@ -67,6 +70,7 @@ impl Pyramid {
             levels,
             bounds: None,
             occupied: CellMask::default(),
+            seen: KeyScratch::default(),
         }
     }
 
@@ -116,7 +120,7 @@ impl Pyramid {
     /// Returns, per level, the keys of the cells that changed.
     pub fn add(&mut self, staged: &[(CellKey, Vector2<f64>)]) -> Vec<Vec<CellKey>> {
         let fine = &mut self.levels[0];
-        let mut seen = FxHashSet::with_capacity_and_hasher(staged.len(), Default::default());
+        let seen = self.seen.take();
         let mut touched = Vec::with_capacity(staged.len());
         let mut run: Option<(CellKey, CellStats)> = None;
         let mut flush = |key: CellKey, stats: &CellStats| {
@@ -160,7 +164,7 @@ impl Pyramid {
         touched_all.push(fine);
         for l in 1..self.levels.len() {
             let below = touched_all[l - 1].len();
-            let mut parents = FxHashSet::with_capacity_and_hasher(below, Default::default());
+            let parents = self.seen.take();
             let mut changed = Vec::with_capacity(below);
             // Changed children come in runs under one parent: the last
             // parent is not looked up again.
@@ -206,7 +210,7 @@ impl Pyramid {
     /// Returns, per level, the keys of the cells that changed (level 0: the
     /// fine cells actually removed).
     pub fn remove(&mut self, keys: &[CellKey]) -> Vec<Vec<CellKey>> {
-        let mut seen = FxHashSet::default();
+        let seen = self.seen.take();
         let mut removed = Vec::new();
         for &key in keys {
             if seen.insert(key) && self.levels[0].cells.remove(&key).is_some() {
