@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 
 import numpy as np
 import pytest
@@ -118,6 +119,48 @@ def test_background_mapper_gives_the_same_poses_and_mapper() -> None:
     np.testing.assert_array_equal(p0, p1)
     assert len(s0) == 5 and s0 == s1
     assert c0 == c1 and sum(c0.values()) > 0
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="os.fork is POSIX only")
+def test_forked_child_has_the_whole_mapper_and_goes_on() -> None:
+    truth = trajectory(30)
+    scans = [polar(pose, seed=k, noise=0.01) for k, pose in enumerate(truth)]
+    config = dict(map_window=4, insert_distance=0.02)
+    inline = ndtgrid.Odometry(config=ndtgrid.OdometryConfig(background_mapper=False, **config))
+    for r, a in scans:
+        inline.step(r, a)
+    want = inline.mapper.to_bytes()
+    odo = ndtgrid.Odometry(config=ndtgrid.OdometryConfig(**config))
+    # Fork right after a batch of 8 scans went to the helper (whether it still holds
+    # them then is a matter of timing; waiting for it before the fork makes the
+    # child's mapper whole either way).
+    k = 0
+    while k < 8 or odo.insertions % 8:
+        odo.step(*scans[k])
+        k += 1
+    read_end, write_end = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: no helper thread; its mapper goes on in line
+        code = 1
+        try:
+            os.close(read_end)
+            for r, a in scans[k:]:
+                odo.step(r, a)
+            with os.fdopen(write_end, "wb") as f:
+                f.write(odo.mapper.to_bytes())
+            code = 0
+        finally:
+            os._exit(code)
+    os.close(write_end)
+    with os.fdopen(read_end, "rb") as f:
+        got = f.read()
+    _, status = os.waitpid(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 0
+    assert got == want
+    # The parent's loop is untouched by the child and goes on as well.
+    for r, a in scans[k:]:
+        odo.step(r, a)
+    assert odo.mapper.to_bytes() == want
 
 
 def test_bad_input_is_rejected_and_leaves_the_loop_unchanged() -> None:

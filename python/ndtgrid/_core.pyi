@@ -1015,6 +1015,8 @@ class OdometryLoop:
         """Cells in the map now."""
     def grid(self) -> NdtGrid:
         """A copy of the map."""
+    def wait_for_mapper(self) -> None:
+        """Wait until a background mapper has taken in every inserted scan."""
     def mapper(self) -> Mapper:
         """A copy of the mapper (grid and §V filter state), once a background mapper
         has taken in every inserted scan."""

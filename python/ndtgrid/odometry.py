@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -161,6 +163,24 @@ class OdometryConfig:
     background_mapper: bool = True
 
 
+#: Every live :class:`Odometry`, so that a fork waits for their mappers first.
+_LIVE: weakref.WeakSet[Odometry] = weakref.WeakSet()
+
+
+def _settle_mappers() -> None:
+    """Before ``os.fork``: wait until every background mapper has taken in its scans.
+
+    A forked child keeps only the forking thread; a scan still held by a mapper's
+    helper thread would be missing from the child's copy of the mapper.
+    """
+    for odo in list(_LIVE):
+        odo._loop.wait_for_mapper()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(before=_settle_mappers)
+
+
 class Odometry:
     """A scan-to-map odometry loop (in the Rust core).
 
@@ -197,9 +217,13 @@ class Odometry:
     predicted pose (recorded) and changes no map. Memory: the map is bounded by
     ``map_window``; the pose history grows by 24 bytes a scan by design.
 
-    ``odo.mapper`` (the §V outlier elimination of ``ndtgrid.Mapper``) arrives with the
-    Mapper; until then the map is a plain :class:`~ndtgrid.NdtGrid` (a copy: :meth:`grid`).
-    Every map change goes through one function of the core, ``Odometry::update_map``.
+    ``odo.mapper`` is the §V outlier elimination of :class:`~ndtgrid.Mapper` run on every
+    inserted scan; scans are matched against a plain :class:`~ndtgrid.NdtGrid` of every
+    inserted point (a copy: :meth:`grid`) unless ``match_filtered_map``. Every map change
+    goes through one function of the core, ``Odometry::update_map``. With
+    ``background_mapper`` (the default) the mapper is updated on a helper thread;
+    ``os.fork`` first waits for it (``os.register_at_fork``), so a forked child holds the
+    whole mapper and goes on updating it in line.
 
     Examples
     --------
@@ -219,6 +243,7 @@ class Odometry:
             )
         self._loop = OdometryLoop(cell_size, **dataclasses.asdict(self._config))
         self._last: OdometryStep | None = None
+        _LIVE.add(self)
 
     @property
     def cell_size(self) -> float:

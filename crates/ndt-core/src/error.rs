@@ -175,6 +175,17 @@ pub enum NdtError {
         /// What is wrong with its content.
         error: Box<NdtError>,
     },
+    /// The odometry's mapper lost scans: its helper thread held them when
+    /// the process forked, and the child has no such thread (flush before
+    /// forking: `Odometry::wait_for_mapper`; Python's `Odometry` does).
+    #[error(
+        "the odometry's mapper lost {batches} batch(es) of scans: its helper thread held them \
+         when the process forked"
+    )]
+    MapperLost {
+        /// Batches of scans lost.
+        batches: usize,
+    },
     /// An output that would be larger than the stated limit.
     #[error("{what}: {size} would exceed the limit of {limit}")]
     TooLarge {

@@ -11,6 +11,14 @@
 //! thread, against an empty mapper with the same options and cell size (the
 //! checks of [`Mapper::insert_scan`] depend on nothing else), so a scan the
 //! mapper would refuse is refused before anything changes.
+//!
+//! Scans are handed over 8 at a time (`BATCH_LENGTH`). A process that forks
+//! keeps only the forking thread: in the child the helper is gone, so the
+//! mapper is then updated in line, and batches the parent's helper still
+//! held are reported as lost ([`NdtError::MapperLost`], by the next insert)
+//! rather than waited for. Waiting for the helper before forking
+//! ([`crate::Odometry::wait_for_mapper`]) loses nothing; Python's `Odometry`
+//! does it before every fork.
 
 use std::fmt;
 use std::ops::Deref;
@@ -122,6 +130,8 @@ pub(crate) struct Behind {
     batch: Mutex<Vec<Job>>,
     batches: Option<SyncSender<Vec<Job>>>,
     thread: Option<JoinHandle<()>>,
+    /// The process the helper runs in (a forked child has no helper).
+    pid: u32,
 }
 
 impl Behind {
@@ -146,7 +156,15 @@ impl Behind {
             batch: Mutex::new(Vec::with_capacity(BATCH_LENGTH)),
             batches: thread.is_some().then_some(tx),
             thread,
+            pid: std::process::id(),
         }
+    }
+
+    /// The helper's queue, when the helper runs in this process.
+    fn helper(&self) -> Option<&SyncSender<Vec<Job>>> {
+        self.batches
+            .as_ref()
+            .filter(|_| std::process::id() == self.pid)
     }
 
     /// Adds `job` to the batch, handing it over when full.
@@ -170,7 +188,7 @@ impl Behind {
     /// Queues `batch` (runs it here when there is no helper).
     fn hand_over(&self, batch: Vec<Job>) {
         lock(&self.shared.state).pending += 1;
-        let batch = match &self.batches {
+        let batch = match self.helper() {
             Some(tx) => match tx.send(batch) {
                 Ok(()) => return,
                 Err(e) => e.0,
@@ -180,9 +198,29 @@ impl Behind {
         serve_batch(&self.shared, batch);
     }
 
+    /// In a forked child, the batches the parent's helper held are lost:
+    /// counted as done, with [`NdtError::MapperLost`] as the error.
+    fn count_lost(&self, progress: &mut Progress) {
+        if self.helper().is_none() && progress.pending > 0 {
+            let batches = std::mem::take(&mut progress.pending);
+            progress
+                .error
+                .get_or_insert(NdtError::MapperLost { batches });
+        }
+    }
+
+    /// The first error a job gave (or a loss, see [`Behind::count_lost`]),
+    /// taken; does not wait.
+    fn take_error(&self) -> Option<NdtError> {
+        let mut progress = lock(&self.shared.state);
+        self.count_lost(&mut progress);
+        progress.error.take()
+    }
+
     /// Waits until every queued job is done; the first error of one.
     fn wait(&self) -> MutexGuard<'_, Progress> {
         let mut progress = lock(&self.shared.state);
+        self.count_lost(&mut progress);
         while progress.pending > 0 {
             progress = self
                 .shared
@@ -198,9 +236,16 @@ impl Drop for Behind {
     fn drop(&mut self) {
         // Hanging up ends the helper after the batches handed over (the
         // rest, unreadable now, is dropped).
+        let here = std::process::id() == self.pid;
         self.batches = None;
         if let Some(thread) = self.thread.take() {
-            let _ = thread.join();
+            if here {
+                let _ = thread.join();
+            } else {
+                // A forked child: the thread is the parent's; only its
+                // handle is here.
+                std::mem::forget(thread);
+            }
         }
     }
 }
@@ -241,20 +286,23 @@ impl MapperHost {
         pose: Pose2,
         stale: Vec<CellKey>,
     ) -> Result<()> {
-        let job = Job {
-            ranges: ranges.to_vec(),
-            angles: angles.to_vec(),
-            pose,
-            stale,
-        };
         match self {
-            Self::Inline(m) => update(m, &job),
+            Self::Inline(m) => {
+                m.insert_scan(ranges, angles, pose)?;
+                m.remove_cells(&stale);
+                Ok(())
+            }
             Self::Behind(b) => {
                 b.checker.check_scan(ranges, angles, pose)?;
-                if let Some(e) = lock(&b.shared.state).error.take() {
+                if let Some(e) = b.take_error() {
                     return Err(e);
                 }
-                b.submit(job);
+                b.submit(Job {
+                    ranges: ranges.to_vec(),
+                    angles: angles.to_vec(),
+                    pose,
+                    stale,
+                });
                 Ok(())
             }
         }
@@ -273,10 +321,17 @@ impl MapperHost {
         match self {
             Self::Inline(m) => MapperView::Inline(m),
             Self::Behind(b) => {
-                b.flush();
-                drop(b.wait());
+                self.settle();
                 MapperView::Locked(b.shared.mapper.read().unwrap_or_else(|e| e.into_inner()))
             }
+        }
+    }
+
+    /// Waits until the helper has taken in every scan (at once in line).
+    pub(crate) fn settle(&self) {
+        if let Self::Behind(b) = self {
+            b.flush();
+            drop(b.wait());
         }
     }
 

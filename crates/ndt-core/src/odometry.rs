@@ -293,6 +293,15 @@ impl Odometry {
         self.mapper.view()
     }
 
+    /// Waits until the mapper has taken in every inserted scan (with
+    /// [`OdometryConfig::background_mapper`]; at once otherwise), as
+    /// [`Odometry::mapper`] does before giving a view. Call it before the
+    /// process forks: a forked child has no helper thread, and the scans it
+    /// still held would be lost (see [`crate::mapworker`]).
+    pub fn wait_for_mapper(&self) {
+        self.mapper.settle();
+    }
+
     /// The pose of every scan so far, in order.
     pub fn poses(&self) -> &[Pose2] {
         &self.poses

@@ -4,11 +4,13 @@ use ndt_core::NdtError;
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
 use pyo3::PyErr;
 
-/// Every [`NdtError`] but a failed file operation is bad input: a
-/// `ValueError` carrying the core's message, which names the argument (or
-/// the file), what was expected and what came. A failed file operation is
-/// an `OSError` with the error number, so that Python picks the subclass
-/// (`FileNotFoundError`, `IsADirectoryError`, ...), and the file name.
+/// Every [`NdtError`] but a failed file operation and a lost mapper is bad
+/// input: a `ValueError` carrying the core's message, which names the
+/// argument (or the file), what was expected and what came. A failed file
+/// operation is an `OSError` with the error number, so that Python picks the
+/// subclass (`FileNotFoundError`, `IsADirectoryError`, ...), and the file
+/// name. An odometry's mapper that lost scans across a fork is a
+/// `RuntimeError`: nothing the caller passed was wrong.
 pub fn to_py(err: NdtError) -> PyErr {
     match err {
         NdtError::Io {
@@ -18,6 +20,7 @@ pub fn to_py(err: NdtError) -> PyErr {
             message,
         } => PyOSError::new_err((errno, format!("cannot {action}: {message}"), path)),
         NdtError::Io { .. } => PyOSError::new_err(err.to_string()),
+        NdtError::MapperLost { .. } => PyRuntimeError::new_err(err.to_string()),
         other => PyValueError::new_err(other.to_string()),
     }
 }

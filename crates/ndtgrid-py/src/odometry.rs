@@ -260,6 +260,11 @@ impl PyOdometry {
         Ok(PyNdtGrid::from(grid))
     }
 
+    /// Waits until a background mapper has taken in every inserted scan.
+    fn wait_for_mapper(&self, py: Python<'_>) -> PyResult<()> {
+        self.with(py, Odometry::wait_for_mapper)
+    }
+
     /// A copy of the mapper (grid and §V filter state) as of this call.
     fn mapper(&self, py: Python<'_>) -> PyResult<crate::mapper::PyMapper> {
         let mapper = self.with(py, |o| o.mapper().clone())?;
