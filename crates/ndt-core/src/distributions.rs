@@ -138,16 +138,16 @@ impl Distributions {
         touched: &[CellKey],
         shape: Option<Shape<'_>>,
     ) {
-        if self.options.fuse_minority {
-            // In and out of the mask by runs (one look-up per run of keys
-            // in one word).
-            self.minority.set_each(touched, |key| {
-                cells.get(&key).is_some_and(|s| s.count < MIN_POINTS)
-            });
+        // With fusion the minority mask takes the touched cells' new counts
+        // before any neighbour is searched (the shaped update does it in its
+        // own pass over the touched cells, which reads their sums anyway).
+        if self.options.fuse_minority && !matches!(self.store, Store::Shaped(_)) {
+            self.minority
+                .set_each(touched, |key| is_minority(cells.get(&key)));
         }
         let options = self.options;
         let search = Search {
-            minority: &self.minority,
+            minority: &mut self.minority,
             seen: self.seen.take(),
         };
         match (&mut self.store, shape) {
@@ -323,8 +323,15 @@ fn update_own(
 /// What the minority-neighbour search of one update reads and keeps track
 /// of: the level's minority cells and the keys met so far (emptied).
 struct Search<'a> {
-    minority: &'a CellMask,
+    minority: &'a mut CellMask,
     seen: &'a mut FxHashSet<CellKey>,
+}
+
+/// Whether a cell with sums `own` is a minority cell (§IV-A(3): fewer than
+/// [`MIN_POINTS`] points; a cell without points is none).
+#[inline]
+fn is_minority(own: Option<&CellStats>) -> bool {
+    own.is_some_and(|s| s.count < MIN_POINTS)
 }
 
 /// `touched`, and with fusion every minority neighbour of a touched cell
@@ -394,16 +401,6 @@ fn update_shaped(
         changed: &changed,
         last: None,
     };
-    // The other touched cells: gone, or a new mean under a shape.
-    for &key in touched {
-        match (cells.get(&key), kinds.of(store, ancestor_of(key))) {
-            (None, _) => store.remove(key),
-            (Some(stats), Some(Ancestor::Shaped(slot))) => {
-                set_shared(store, cell_size, key, stats, slot);
-            }
-            _ => {}
-        }
-    }
     // A new distribution of their own for those without a shape, and with
     // fusion for their minority neighbours without one (a cell gone or
     // changed changes its neighbours' fused sums). A touched cell inside its
@@ -415,11 +412,37 @@ fn update_shaped(
         let (x, y) = (k.ix & (side - 1), k.iy & (side - 1));
         x > 0 && y > 0 && x < side - 1 && y < side - 1
     };
-    let searched: Vec<CellKey> = touched
-        .iter()
-        .copied()
-        .filter(|&k| !inside(k) || kinds.of(store, ancestor_of(k)) == Some(Ancestor::Unshaped))
-        .collect();
+    let mut searched = Vec::with_capacity(touched.len());
+    let mut minority = Vec::with_capacity(if options.fuse_minority {
+        touched.len()
+    } else {
+        0
+    });
+    // The other touched cells: gone, or a new mean under a shape; their
+    // minority flags; those to search.
+    for &key in touched {
+        let own = cells.get(&key);
+        let kind = kinds.of(store, ancestor_of(key));
+        match (own, kind) {
+            (None, _) => store.remove(key),
+            (Some(stats), Some(Ancestor::Shaped(slot))) => {
+                set_shared(store, cell_size, key, stats, slot);
+            }
+            _ => {}
+        }
+        if options.fuse_minority {
+            minority.push(is_minority(own));
+        }
+        if !inside(key) || kind == Some(Ancestor::Unshaped) {
+            searched.push(key);
+        }
+    }
+    if options.fuse_minority {
+        let mut flags = minority.into_iter();
+        search
+            .minority
+            .set_each(touched, |_| flags.next().unwrap_or(false));
+    }
     let unshaped = with_minority_neighbours(search, options, &searched, |k| {
         kinds.of(store, ancestor_of(k)) == Some(Ancestor::Unshaped)
     });
