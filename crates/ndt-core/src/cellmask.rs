@@ -43,22 +43,7 @@ impl CellMask {
     /// look-up per run of keys in one block (a scan's cells come in runs
     /// along its surfaces), otherwise as [`CellMask::set`] key by key.
     pub fn set_all(&mut self, keys: &[CellKey], member: bool) {
-        let mut run: Option<((i32, i32), u64)> = None;
-        for &key in keys {
-            let (block, bit) = split(key);
-            match &mut run {
-                Some((b, bits)) if *b == block => *bits |= 1 << bit,
-                _ => {
-                    if let Some((b, bits)) = run.take() {
-                        self.apply(b, bits, member);
-                    }
-                    run = Some((block, 1 << bit));
-                }
-            }
-        }
-        if let Some((b, bits)) = run {
-            self.apply(b, bits, member);
-        }
+        self.set_each(keys, |_| member);
     }
 
     /// Puts each key of `keys` in the set or takes it out as `member` says:
@@ -104,21 +89,9 @@ impl CellMask {
         }
     }
 
-    fn apply(&mut self, block: (i32, i32), bits: u64, member: bool) {
-        if member {
-            *self.blocks.entry(block).or_insert(0) |= bits;
-        } else if let Some(word) = self.blocks.get_mut(&block) {
-            *word &= !bits;
-            if *word == 0 {
-                self.blocks.remove(&block);
-            }
-        }
-    }
-
     /// Puts `key` in the set (`true`) or takes it out.
     pub fn set(&mut self, key: CellKey, member: bool) {
-        let (block, bit) = split(key);
-        self.apply(block, 1 << bit, member);
+        self.set_all(&[key], member);
     }
 
     /// A reader that remembers the last block it used.

@@ -378,7 +378,8 @@ fn update_shaped(
     let ancestor_of = |k: CellKey| crate::pyramid::coarse_key(k, depth);
     // The touched cells' ancestors, each once (a scan's cells come in runs
     // under one ancestor): those whose kind changed set all their cells again.
-    let mut seen = FxHashSet::with_capacity_and_hasher(touched.len() / 4, Default::default());
+    // (The search's scratch set, emptied again before the search.)
+    let seen = &mut *search.seen;
     let mut changed = FxHashSet::default();
     let mut last = None;
     for &key in touched {
@@ -390,6 +391,7 @@ fn update_shaped(
             }
         }
     }
+    seen.clear();
     if !changed.is_empty() {
         for (at, key, own) in s.descendants(&changed) {
             set_cell(store, cells, cell_size, options, at, key, own);

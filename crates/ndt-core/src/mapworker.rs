@@ -28,6 +28,7 @@ use std::thread::JoinHandle;
 
 use crate::error::{NdtError, Result};
 use crate::key::CellKey;
+use crate::mapper::CheckedScan;
 use crate::mapper::Mapper;
 use crate::se2::Pose2;
 
@@ -40,11 +41,9 @@ const BATCH_LENGTH: usize = 8;
 /// and the copies of scans it holds).
 const QUEUE_LENGTH: usize = 2;
 
-/// One inserted scan, then the cells the map window drops.
+/// One inserted scan (checked), then the cells the map window drops.
 struct Job {
-    ranges: Vec<f64>,
-    angles: Vec<f64>,
-    pose: Pose2,
+    scan: CheckedScan,
     stale: Vec<CellKey>,
 }
 
@@ -89,10 +88,11 @@ fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// The scan of `job` into `mapper`, then its removals.
-fn update(mapper: &mut Mapper, job: &Job) -> Result<()> {
-    mapper.insert_scan(&job.ranges, &job.angles, job.pose)?;
-    mapper.remove_cells(&job.stale);
+/// A checked scan into `mapper`, then the window's removals `stale`: what a
+/// job does, and what the loop does in line.
+fn apply_scan(mapper: &mut Mapper, scan: CheckedScan, stale: &[CellKey]) -> Result<()> {
+    mapper.insert_checked(scan)?;
+    mapper.remove_cells(stale);
     Ok(())
 }
 
@@ -104,8 +104,8 @@ fn serve_batch(shared: &Shared, batch: Vec<Job>) {
         result: Ok(()),
     };
     let mut mapper = shared.mapper.write().unwrap_or_else(|e| e.into_inner());
-    for job in &batch {
-        let result = update(&mut mapper, job);
+    for job in batch {
+        let result = apply_scan(&mut mapper, job.scan, &job.stale);
         if done.result.is_ok() {
             done.result = result;
         }
@@ -217,8 +217,8 @@ impl Behind {
         progress.error.take()
     }
 
-    /// Waits until every queued job is done; the first error of one.
-    fn wait(&self) -> MutexGuard<'_, Progress> {
+    /// Waits until every queued job is done.
+    fn wait(&self) {
         let mut progress = lock(&self.shared.state);
         self.count_lost(&mut progress);
         while progress.pending > 0 {
@@ -228,7 +228,6 @@ impl Behind {
                 .wait(progress)
                 .unwrap_or_else(|e| e.into_inner());
         }
-        progress
     }
 }
 
@@ -267,42 +266,32 @@ impl MapperHost {
         })
     }
 
-    /// The checks of [`Mapper::insert_scan`] alone; changes nothing.
-    pub(crate) fn check_scan(&self, ranges: &[f64], angles: &[f64], pose: Pose2) -> Result<()> {
-        match self {
-            Self::Inline(m) => m.check_scan(ranges, angles, pose),
-            Self::Behind(b) => b.checker.check_scan(ranges, angles, pose),
-        }
-    }
-
-    /// [`Mapper::insert_scan`] of one scan, then [`Mapper::remove_cells`]
-    /// of `stale`: now, or queued as one job. A queued scan is checked
-    /// first; an error of an earlier job (none is expected: each was
-    /// checked) is returned here and nothing is queued.
-    pub(crate) fn update(
-        &mut self,
+    /// The checks of [`Mapper::insert_scan`] alone, and behind the loop the
+    /// error an earlier job gave (none is expected: each was checked; a
+    /// fork may lose batches), taken: the loop calls this before anything
+    /// changes, so a refused scan leaves both maps as they were.
+    pub(crate) fn check_scan(
+        &self,
         ranges: &[f64],
         angles: &[f64],
         pose: Pose2,
-        stale: Vec<CellKey>,
-    ) -> Result<()> {
+    ) -> Result<CheckedScan> {
         match self {
-            Self::Inline(m) => {
-                m.insert_scan(ranges, angles, pose)?;
-                m.remove_cells(&stale);
-                Ok(())
-            }
+            Self::Inline(m) => m.check_scan(ranges, angles, pose),
             Self::Behind(b) => {
-                b.checker.check_scan(ranges, angles, pose)?;
-                if let Some(e) = b.take_error() {
-                    return Err(e);
-                }
-                b.submit(Job {
-                    ranges: ranges.to_vec(),
-                    angles: angles.to_vec(),
-                    pose,
-                    stale,
-                });
+                let scan = b.checker.check_scan(ranges, angles, pose)?;
+                b.take_error().map_or(Ok(scan), Err)
+            }
+        }
+    }
+
+    /// A scan [`MapperHost::check_scan`] passed into the mapper, then
+    /// [`Mapper::remove_cells`] of `stale`: now, or queued as one job.
+    pub(crate) fn update(&mut self, scan: CheckedScan, stale: Vec<CellKey>) -> Result<()> {
+        match self {
+            Self::Inline(m) => apply_scan(m, scan, &stale),
+            Self::Behind(b) => {
+                b.submit(Job { scan, stale });
                 Ok(())
             }
         }
@@ -331,7 +320,7 @@ impl MapperHost {
     pub(crate) fn settle(&self) {
         if let Self::Behind(b) = self {
             b.flush();
-            drop(b.wait());
+            b.wait();
         }
     }
 

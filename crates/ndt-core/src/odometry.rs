@@ -469,7 +469,7 @@ impl Odometry {
         // Both maps check the scan before either changes; then neither
         // insertion can fail (the mapper's only failures are its checks and
         // its grid's, on the same beams).
-        self.mapper.check_scan(ranges, angles, pose)?;
+        let checked = self.mapper.check_scan(ranges, angles, pose)?;
         let touched = if self.config.match_filtered_map {
             // The cells this scan touched (the filter stores a subset of
             // them), each once.
@@ -489,7 +489,7 @@ impl Odometry {
         let stale = self.record_insertion(touched, pose);
         // The mapper takes the scan, then loses the same stale cells: in
         // line, or queued behind the loop as one job.
-        self.mapper.update(ranges, angles, pose, stale)
+        self.mapper.update(checked, stale)
     }
 
     fn valid_points(&self, ranges: &[f64], angles: &[f64]) -> Result<Vec<[f64; 2]>> {

@@ -10,6 +10,8 @@ mod options;
 mod pipeline;
 mod restore;
 
+pub(crate) use pipeline::CheckedScan;
+
 pub use counts::RemovalCounts;
 pub use options::MapperOptions;
 pub use restore::MAX_COUNTER;
@@ -160,10 +162,21 @@ impl Mapper {
             .insert_scan(&mut self.grid, ranges, angles, pose)
     }
 
-    /// Whether [`Mapper::insert_scan`] would accept this scan (it changes
-    /// nothing; see [`MapFilter::check_scan`]).
-    pub(crate) fn check_scan(&self, ranges: &[f64], angles: &[f64], pose: Pose2) -> Result<()> {
+    /// The checks of [`Mapper::insert_scan`], changing nothing (see
+    /// [`MapFilter::check_scan`]).
+    pub(crate) fn check_scan(
+        &self,
+        ranges: &[f64],
+        angles: &[f64],
+        pose: Pose2,
+    ) -> Result<CheckedScan> {
         self.filter.check_scan(&self.grid, ranges, angles, pose)
+    }
+
+    /// Adds a scan [`Mapper::check_scan`] passed, on this mapper or on one
+    /// with the same options and cell size (see [`MapFilter::insert_checked`]).
+    pub(crate) fn insert_checked(&mut self, checked: CheckedScan) -> Result<()> {
+        self.filter.insert_checked(&mut self.grid, checked)
     }
 
     /// The map matched against.

@@ -17,6 +17,13 @@ use crate::key::CellKey;
 use crate::ranges::check_beams;
 use crate::se2::Pose2;
 
+/// A scan that passed [`MapFilter::check_scan`]: its valid beams and pose.
+#[derive(Debug, Clone)]
+pub(crate) struct CheckedScan {
+    beams: Vec<Beam>,
+    pose: Pose2,
+}
+
 /// Which step dropped a point of the new scan.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Dropped {
@@ -47,7 +54,18 @@ impl MapFilter {
         angles: &[f64],
         pose: Pose2,
     ) -> Result<()> {
-        let beams = self.valid_beams(grid, ranges, angles, pose)?;
+        let scan = self.check_scan(grid, ranges, angles, pose)?;
+        self.insert_checked(grid, scan)
+    }
+
+    /// [`MapFilter::insert_scan`] of a scan [`MapFilter::check_scan`] passed
+    /// (for this filter's options and `grid`'s cell size).
+    pub(crate) fn insert_checked(
+        &mut self,
+        grid: &mut NdtGrid,
+        checked: CheckedScan,
+    ) -> Result<()> {
+        let CheckedScan { beams, pose } = checked;
         // A scan with no valid beam (a blinded sensor, a driver sending only
         // NaN, 0 or inf) observes nothing: it changes neither the map nor the
         // filter, not even the scan counter, so a burst of them cannot age
@@ -184,17 +202,20 @@ impl MapFilter {
         Ok(())
     }
 
-    /// The checks of [`MapFilter::insert_scan`] alone: `Ok` means the same
-    /// call would not fail (its only failures are these checks and the
-    /// grid's, on the same beams).
+    /// The checks of [`MapFilter::insert_scan`] alone, changing nothing: the
+    /// scan's valid beams, which [`MapFilter::insert_checked`] then takes
+    /// without checking them again (and does not fail on: its only other
+    /// failures are the grid's checks of the same points). They depend on
+    /// the options and the grid's cell size alone.
     pub(crate) fn check_scan(
         &self,
         grid: &NdtGrid,
         ranges: &[f64],
         angles: &[f64],
         pose: Pose2,
-    ) -> Result<()> {
-        self.valid_beams(grid, ranges, angles, pose).map(drop)
+    ) -> Result<CheckedScan> {
+        let beams = self.valid_beams(grid, ranges, angles, pose)?;
+        Ok(CheckedScan { beams, pose })
     }
 
     /// The valid beams of a scan, checked: lengths, finite angles and pose,
