@@ -14,7 +14,8 @@ as a Markdown table to stdout as soon as it is measured (progress goes to stderr
    against ``small_gicp.GaussianVoxelMap.insert`` and KISS-ICP's ``VoxelHashMap.update``
    of the same scan.
 3. **Odometry over the whole Intel log** (13,631 scans): ``ndtgrid.Odometry(cell_size=0.02)``
-   (in a child process, which also reports the run's peak resident memory) against the
+   (each run in a fresh child process, which also reports the run's peak resident memory;
+   the default loop three times, judged on the median run) against the
    small_gicp voxel-map odometry of ``benches/datasets.py`` and KISS-ICP (when
    ``kiss-icp`` is installed), with the relation error of each.
 4. **Sweeps**: match time against the number of scan points (simulated scans, 100-4000
@@ -822,16 +823,25 @@ def section_odometry(args: argparse.Namespace) -> dict[str, Any]:
     if not INTEL_SPLIT.exists():
         out("Intel log absent: skipped.")
         return {}
-    log("Intel: ndtgrid.Odometry in a child process ...")
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "poses.npy")
         argv = ["--intel-child", "--intel-scans", str(args.intel_scans), "--out", path]
-        info = child(argv)
-        our_poses = np.load(path)
+        # Our default loop runs `intel_runs` times, each in a fresh process: one run on
+        # this VM varies by about ±5 %, so the target is judged on the median run.
+        infos, all_poses = [], []
+        for k in range(args.intel_runs):
+            log(f"Intel: ndtgrid.Odometry in a child process (run {k + 1}/{args.intel_runs}) ...")
+            infos.append(child(argv))
+            all_poses.append(np.load(path))
+        order = sorted(range(len(infos)), key=lambda k: float(infos[k]["seconds"]))
+        info = infos[order[len(order) // 2]]
+        our_poses = all_poses[0]
+        repeatable = all(np.array_equal(our_poses, p) for p in all_poses)
         log("Intel: the same with the mapper in line (one thread) ...")
         info_1 = child([*argv, "--one-thread"])
         poses_1 = np.load(path)
     n = int(info["scans"])
+    run_times = ", ".join(f"{float(i['seconds']):.2f}" for i in infos)
     log(f"  ndtgrid: {info['seconds']:.2f} s for {n} scans ({info_1['seconds']:.2f} s one thread)")
     scans = [s for _, s in zip(range(n), read_benchmark_split(INTEL_SPLIT))]
     same = np.array_equal(our_poses, poses_1)
@@ -840,7 +850,9 @@ def section_odometry(args: argparse.Namespace) -> dict[str, Any]:
             "ndtgrid `Odometry(cell_size=0.02)` (defaults)",
             our_poses,
             float(info["seconds"]),
-            "Rust loop (one `step` call per scan); the mapper (§V) on a helper thread",
+            "Rust loop (one `step` call per scan); the mapper (§V) on a helper thread; "
+            f"median of {len(infos)} runs in fresh processes ({run_times} s), poses "
+            f"{'identical' if repeatable else 'DIFFERENT'} in every run",
         ),
         OdoRun(
             "ndtgrid, `background_mapper=False` (one thread)",
@@ -918,6 +930,7 @@ def section_odometry(args: argparse.Namespace) -> dict[str, Any]:
     res: dict[str, Any] = {
         "scans": n,
         "ours": ours_s,
+        "ours_runs": [float(i["seconds"]) for i in infos],
         "ours_one_thread": runs[1].seconds,
         "vmhwm_mib": info["vmhwm_kib"] * mib,
     }
@@ -1407,7 +1420,8 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
         full = o["scans"] >= 13631
         row(
             f"Intel log through `Odometry` ≤ 3 s ({o['scans']} scans)",
-            f"{o['ours']:.2f} s ({1e3 * o['ours'] / o['scans']:.3f} ms / scan); "
+            f"{o['ours']:.2f} s ({1e3 * o['ours'] / o['scans']:.3f} ms / scan), median of "
+            f"{len(o['ours_runs'])} runs: {', '.join(f'{t:.2f}' for t in o['ours_runs'])} s; "
             f"one thread {o['ours_one_thread']:.2f} s",
             o["ours"] <= 3.0 if full else None,
         )
@@ -1488,6 +1502,9 @@ def main() -> int:
     ap.add_argument("--inserts", type=int, help="timed inserts per set (default 300)")
     ap.add_argument("--intel-scans", type=int, help="Intel scans for odometry (default all)")
     ap.add_argument(
+        "--intel-runs", type=int, help="runs of our Intel loop; the median is judged (default 3)"
+    )
+    ap.add_argument(
         "--plot",
         help="sweep plot path (default docs/img/speed_sweeps.png; none with --quick unless given)",
     )
@@ -1504,6 +1521,7 @@ def main() -> int:
         "starts": 3 if q else 8,
         "inserts": 60 if q else 300,
         "intel_scans": 2000 if q else 10**9,
+        "intel_runs": 1 if q else 3,
     }
     for k, v in defaults.items():
         if getattr(args, k) is None:
