@@ -68,13 +68,16 @@ def progress(label: str, k: int, n: int, start: float) -> None:
         print(f"  {label}: {k}/{n} scans ({rate:.0f} scans/s)", file=sys.stderr, flush=True)
 
 
-def run_ndtgrid(scans: list[Scan]) -> Run:
-    """``ndtgrid.Odometry`` with its defaults over the scans."""
-    odo = ndtgrid.Odometry(cell_size=0.02)
+def run_ndtgrid(scans: list[Scan], config: ndtgrid.OdometryConfig | None = None) -> Run:
+    """``ndtgrid.Odometry`` (2 cm; its defaults unless ``config``) over the scans. The
+    time ends with a read of ``odo.mapper``, which waits for the mapper's helper thread
+    to take in the last scans."""
+    odo = ndtgrid.Odometry(cell_size=0.02, config=config)
     start = time.perf_counter()
     for k, s in enumerate(scans, start=1):
         odo.step(s.ranges, s.angles, s.odom)
         progress("ndtgrid", k, len(scans), start)
+    _ = odo.mapper
     return Run(odo.poses, time.perf_counter() - start)
 
 

@@ -17,12 +17,11 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from datasets import DATA, DATASETS, machine
+from datasets import DATA, DATASETS, machine, run_ndtgrid
 
 import ndtgrid
 from ndtgrid.evaluation import RelationSummary, relation_errors
@@ -36,13 +35,8 @@ def run(name: str, value: float) -> tuple[float, RelationSummary]:
     stem = DATASETS[name][0]
     scans = list(read_benchmark_split(DATA / f"{name}.tar.gz"))
     index = read_benchmark_index(DATA / f"{stem}__index.csv")
-    odo = ndtgrid.Odometry(0.02, ndtgrid.OdometryConfig(coarse_rotation_search=value))
-    start = time.perf_counter()
-    for s in scans:
-        odo.step(s.ranges, s.angles, s.odom)
-    _ = odo.mapper  # waits for the helper: part of the run
-    seconds = time.perf_counter() - start
-    return seconds, relation_errors(odo.poses[index.raw_scan], index.corrected).summary()
+    ours = run_ndtgrid(scans, ndtgrid.OdometryConfig(coarse_rotation_search=value))
+    return ours.seconds, relation_errors(ours.poses[index.raw_scan], index.corrected).summary()
 
 
 def main() -> None:

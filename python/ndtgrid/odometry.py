@@ -220,10 +220,10 @@ class Odometry:
     ``odo.mapper`` is the §V outlier elimination of :class:`~ndtgrid.Mapper` run on every
     inserted scan; scans are matched against a plain :class:`~ndtgrid.NdtGrid` of every
     inserted point (a copy: :meth:`grid`) unless ``match_filtered_map``. Every map change
-    goes through one function of the core, ``Odometry::update_map``. With
-    ``background_mapper`` (the default) the mapper is updated on a helper thread;
-    ``os.fork`` first waits for it (``os.register_at_fork``), so a forked child holds the
-    whole mapper and goes on updating it in line.
+    goes through one function of the core (``Odometry::insert_points``, behind
+    ``update_map``). With ``background_mapper`` (the default) the mapper is updated on a
+    helper thread; ``os.fork`` first waits for it (``os.register_at_fork``), so a forked
+    child holds the whole mapper and goes on updating it in line.
 
     Examples
     --------

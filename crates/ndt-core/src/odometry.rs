@@ -2,9 +2,10 @@
 //! prior, match the scan against the map (§III-A with the fixes of §IV-A),
 //! and add it to the map when the robot has moved enough.
 //!
-//! Every change to the map goes through one function,
-//! [`Odometry::update_map`], so the map can be swapped for one with the §V
-//! outlier elimination without touching the loop.
+//! Every change to the maps goes through one private function,
+//! `Odometry::insert_points` (behind [`Odometry::update_map`], and called by
+//! [`Odometry::step`] with the points it already has), so the map can be
+//! swapped for one with the §V outlier elimination without touching the loop.
 //!
 //! **Memory bound.** The grid is sparse, so it grows with the mapped area; an
 //! odometry without loop closure also re-maps a place it comes back to with
@@ -448,16 +449,17 @@ impl Odometry {
         })
     }
 
-    /// Adds a scan seen from `pose` to the map: the one place where the map
-    /// changes (insertion, then the memory bound). All-or-nothing: on error
-    /// the map is unchanged.
+    /// Adds a scan seen from `pose` to the map (insertion, then the memory
+    /// bound), as [`Odometry::step`] does when it inserts. All-or-nothing: on
+    /// error the map is unchanged.
     pub fn update_map(&mut self, ranges: &[f64], angles: &[f64], pose: Pose2) -> Result<()> {
         let points = self.valid_points(ranges, angles)?;
         self.insert_points(&points, ranges, angles, pose)
     }
 
     /// [`Odometry::update_map`] with the scan's valid points already taken
-    /// from `ranges` and `angles` (as [`Odometry::step`] has them).
+    /// from `ranges` and `angles` (as [`Odometry::step`] has them): the one
+    /// place where the maps change.
     fn insert_points(
         &mut self,
         points: &[[f64; 2]],
