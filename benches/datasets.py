@@ -56,10 +56,12 @@ PROGRESS_EVERY = 2000
 
 @dataclass
 class Run:
-    """Poses of one method over a log and its time per scan."""
+    """Poses of one method over a log, its time, and (ours) the scans whose match ran the
+    rotational multi-start (``OdometryStep.multi_start``)."""
 
     poses: F64
     seconds: float
+    multi_starts: int = 0
 
 
 def progress(label: str, k: int, n: int, start: float) -> None:
@@ -73,12 +75,15 @@ def run_ndtgrid(scans: list[Scan], config: ndtgrid.OdometryConfig | None = None)
     time ends with a read of ``odo.mapper``, which waits for the mapper's helper thread
     to take in the last scans."""
     odo = ndtgrid.Odometry(cell_size=0.02, config=config)
+    multi_starts = 0
     start = time.perf_counter()
     for k, s in enumerate(scans, start=1):
         odo.step(s.ranges, s.angles, s.odom)
+        step = odo.last_step
+        multi_starts += step is not None and step.multi_start
         progress("ndtgrid", k, len(scans), start)
     _ = odo.mapper
-    return Run(odo.poses, time.perf_counter() - start)
+    return Run(odo.poses, time.perf_counter() - start, multi_starts)
 
 
 def matrix(p: F64) -> F64:

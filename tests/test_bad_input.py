@@ -649,6 +649,11 @@ ODOMETRY_CONFIG_CASES = [
     ({"levels": 0}, f"{LEVELS} 0"),
     ({"levels": 7}, f"{LEVELS} 7"),
     ({"coarse_rotation_search": 4.0}, "rotation_search: expected an angle in [0, pi] rad, got 4"),
+    (
+        {"coarse_rotation_gate": -0.5},
+        "coarse_rotation_gate: expected a fraction >= 0 (inf = the multi-start on every scan), "
+        "got -0.5",
+    ),
     ({"max_step_cells": np.inf}, "max_step_cells: expected a finite value > 0, got inf"),
     ({"max_step_rotation": 0.0}, "max_step_rotation: expected a finite value > 0, got 0"),
 ]

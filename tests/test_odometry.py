@@ -85,6 +85,30 @@ def test_odometry_prior_is_used_and_corrected() -> None:
     assert raw_dt > 0.1 and raw_dr > math.radians(20)
 
 
+def test_multi_start_runs_on_every_scan_or_behind_the_gate() -> None:
+    truth = trajectory(30)
+    ran = {}
+    for gate in (math.inf, 0.8):
+        odo = ndtgrid.Odometry(config=ndtgrid.OdometryConfig(coarse_rotation_gate=gate))
+        flags = []
+        for k, pose in enumerate(truth):
+            r, a = polar(pose, seed=k, noise=0.005)
+            odo.step(r, a)
+            step = odo.last_step
+            assert step is not None
+            flags.append(step.multi_start)
+        ran[gate] = flags
+        est = np.array([se2.between(odo.poses[0], p) for p in odo.poses])
+        ref = np.array([se2.between(truth[0], p) for p in truth])
+        dt, dr = errors(est, ref)
+        assert dt < 0.02 and dr < math.radians(0.5), gate
+    # The first scan has no map to match; with the gate, the first 8 accepted
+    # matches still run the multi-start, and a smooth path needs it no more.
+    assert ran[math.inf] == [False] + [True] * 29
+    assert ran[0.8][:9] == [False] + [True] * 8
+    assert sum(ran[0.8][9:]) <= 2
+
+
 def test_map_window_bounds_the_map() -> None:
     truth = trajectory(80)
     bounded = ndtgrid.Odometry(config=ndtgrid.OdometryConfig(map_window=5, insert_distance=0.02))

@@ -913,6 +913,9 @@ class OdometryStep:
     accepted : bool
         The match was used (``num_matched >= min_match_ratio * num_points``);
         otherwise ``pose`` is the prediction.
+    multi_start : bool
+        The kept match ran the matcher's rotational multi-start (see
+        ``coarse_rotation_gate`` of :class:`ndtgrid.OdometryConfig`).
     inserted : bool
         The scan was added to the map.
     converged, iterations, num_matched
@@ -929,6 +932,8 @@ class OdometryStep:
     def matched(self) -> bool: ...
     @property
     def accepted(self) -> bool: ...
+    @property
+    def multi_start(self) -> bool: ...
     @property
     def inserted(self) -> bool: ...
     @property
@@ -983,6 +988,7 @@ class OdometryLoop:
         max_step_rotation: float | None = None,
         levels: int | None = None,
         coarse_rotation_search: float | None = None,
+        coarse_rotation_gate: float | None = None,
         freeze_unconstrained: bool | None = None,
         freeze_ratio: float | None = None,
         coarse_model: bool | None = None,

@@ -29,11 +29,22 @@ use crate::matcher::{MatchOptions, MatchResult};
 use crate::ranges::points_from_ranges;
 use crate::se2::Pose2;
 
+/// The default [`OdometryConfig::coarse_rotation_gate`].
+pub const DEFAULT_ROTATION_GATE: f64 = 0.8;
+
 /// σ floor \[m\] of the loop's matcher (see [`OdometryConfig::matcher`]).
 pub const ODOMETRY_SIGMA_FLOOR: f64 = 0.005;
 
 /// Most rotations tried on each side of the prediction by the rotation search.
 const MAX_ROTATION_CANDIDATES: f64 = 1000.0;
+
+/// Accepted matches whose score per point [`OdometryConfig::coarse_rotation_gate`]
+/// takes the median of.
+pub const GATE_HISTORY: usize = 32;
+
+/// Accepted matches the loop needs before [`OdometryConfig::coarse_rotation_gate`]
+/// applies: until then every match runs the rotational multi-start.
+pub const GATE_MIN_HISTORY: usize = 8;
 
 /// Settings of the loop. Units: metres and radians.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -78,6 +89,26 @@ pub struct OdometryConfig {
     pub prior_gap_distance: f64,
     /// The rotation of that gap \[rad\].
     pub prior_gap_angle: f64,
+    /// When the matcher's rotational multi-start
+    /// ([`MatchOptions::rotation_search`]) runs. It is the most expensive
+    /// part of a match, and from a good prior it rarely changes the result;
+    /// but from a poor one (no odometry, a fast turn) it is what keeps the
+    /// rotation. So a scan is first matched without it and matched again
+    /// with it (that result kept, see [`StepOutcome::multi_start`]) only
+    /// when the first match fails [`OdometryConfig::min_match_ratio`] or its
+    /// score of eq. (1) per point is below this fraction of the median of
+    /// the last [`GATE_HISTORY`] accepted matches' (and for the first
+    /// [`GATE_MIN_HISTORY`] accepted matches). `inf` = every scan runs the
+    /// multi-start (no first try); 0 = only after a failed match.
+    ///
+    /// 0.8 measured on the five benchmark logs (`benches/rotation_sweep.py`,
+    /// BENCHMARK.md, "Speed"): with their odometry, mean relation errors
+    /// equal to those with the multi-start on every scan or lower (MIT
+    /// Killian 0.045 m against 0.048 m), in 17 % less time on Intel, with
+    /// 0.3–2.8 % of the scans running the multi-start; without odometry the
+    /// multi-start off altogether let MIT Killian's rotation error reach 57°,
+    /// this gate 2.4°.
+    pub coarse_rotation_gate: f64,
     /// The matcher's options (§IV-A). The loop's default differs from the
     /// paper's in one place: `expansion` (`k` of eq. 8) is 30, not 10 —
     /// measured on the benchmark logs (1° SICK beams, whose 2 cm cells hold
@@ -131,6 +162,7 @@ impl Default for OdometryConfig {
             rotation_step: 1f64.to_radians(),
             prior_gap_distance: 0.1,
             prior_gap_angle: 5f64.to_radians(),
+            coarse_rotation_gate: DEFAULT_ROTATION_GATE,
             matcher: MatchOptions {
                 expansion: 30.0,
                 sigma_floor: ODOMETRY_SIGMA_FLOOR,
@@ -165,6 +197,13 @@ impl OdometryConfig {
             });
         }
         non_negative("rotation_search", self.rotation_search)?;
+        if self.coarse_rotation_gate.is_nan() || self.coarse_rotation_gate < 0.0 {
+            return Err(NdtError::InvalidOption {
+                name: "coarse_rotation_gate",
+                expected: "a fraction >= 0 (inf = the multi-start on every scan)",
+                value: self.coarse_rotation_gate,
+            });
+        }
         for (name, v) in [
             ("prior_gap_distance", self.prior_gap_distance),
             ("prior_gap_angle", self.prior_gap_angle),
@@ -223,10 +262,21 @@ pub struct StepOutcome {
     /// The match was used (see [`OdometryConfig::min_match_ratio`]); when
     /// `false`, `pose` is the prediction.
     pub accepted: bool,
+    /// The kept match ran the matcher's rotational multi-start (see
+    /// [`OdometryConfig::coarse_rotation_gate`]).
+    pub multi_start: bool,
     /// The scan was added to the map.
     pub inserted: bool,
     /// Valid points of the scan (beams within the range limits).
     pub num_points: usize,
+}
+
+/// One match of [`Odometry::step`]: the result, whether it passes
+/// [`OdometryConfig::min_match_ratio`], and whether it ran the multi-start.
+struct Attempt {
+    res: MatchResult,
+    accepted: bool,
+    multi_start: bool,
 }
 
 /// The scan-to-map odometry loop (see the module documentation).
@@ -243,6 +293,9 @@ pub struct Odometry {
     stamps: FxHashMap<CellKey, u64>,
     /// Cells hit by each of the last `map_window` insertions.
     history: VecDeque<(u64, Vec<CellKey>)>,
+    /// Score of eq. (1) per point of the last [`GATE_HISTORY`] accepted
+    /// matches (see [`OdometryConfig::coarse_rotation_gate`]).
+    scores: VecDeque<f64>,
 }
 
 impl Odometry {
@@ -267,6 +320,7 @@ impl Odometry {
             insertions: 0,
             stamps: FxHashMap::default(),
             history: VecDeque::new(),
+            scores: VecDeque::with_capacity(GATE_HISTORY + 1),
         })
     }
 
@@ -332,16 +386,64 @@ impl Odometry {
         Some(last.compose(self.last_odom?.between(odom?)))
     }
 
-    /// Matches `points` from `prediction` (after the rotation search); the
-    /// result and whether it passes [`OdometryConfig::min_match_ratio`].
-    fn match_from(&self, points: &[[f64; 2]], prediction: Pose2) -> Result<(MatchResult, bool)> {
+    /// Matches `points` from `prediction` (after the rotation search): first
+    /// without the rotational multi-start when the gate allows, then with it
+    /// when that match looks poor ([`OdometryConfig::coarse_rotation_gate`]).
+    fn match_from(&self, points: &[[f64; 2]], prediction: Pose2) -> Result<Attempt> {
         let start = self.rotation_start(points, prediction)?;
-        let res = self
-            .grid()
-            .match_scan(points, start, &self.config.matcher)?;
-        let ratio = res.num_matched as f64 / points.len() as f64;
-        let accepted = res.num_matched > 0 && ratio >= self.config.min_match_ratio;
-        Ok((res, accepted))
+        let full = &self.config.matcher;
+        if let Some(bar) = self.gate_bar() {
+            let quick = MatchOptions {
+                rotation_search: 0.0,
+                ..*full
+            };
+            let res = self.grid().match_scan(points, start, &quick)?;
+            let accepted = self.passes(&res, points.len());
+            if accepted && res.score / points.len() as f64 >= bar {
+                return Ok(Attempt {
+                    res,
+                    accepted,
+                    multi_start: false,
+                });
+            }
+        }
+        let res = self.grid().match_scan(points, start, full)?;
+        Ok(Attempt {
+            accepted: self.passes(&res, points.len()),
+            multi_start: full.rotation_search > 0.0,
+            res,
+        })
+    }
+
+    /// Whether `res` passes [`OdometryConfig::min_match_ratio`] for a scan of
+    /// `points` valid points.
+    fn passes(&self, res: &MatchResult, points: usize) -> bool {
+        let ratio = res.num_matched as f64 / points as f64;
+        res.num_matched > 0 && ratio >= self.config.min_match_ratio
+    }
+
+    /// The score per point a match without the multi-start must reach to be
+    /// kept ([`OdometryConfig::coarse_rotation_gate`]); `None` when every
+    /// match runs the multi-start, or has none to run.
+    fn gate_bar(&self) -> Option<f64> {
+        let gate = self.config.coarse_rotation_gate;
+        if !(self.config.matcher.rotation_search > 0.0 && gate.is_finite())
+            || self.scores.len() < GATE_MIN_HISTORY
+        {
+            return None;
+        }
+        let mut recent: Vec<f64> = self.scores.iter().copied().collect();
+        let mid = recent.len() / 2;
+        let (_, median, _) = recent.select_nth_unstable_by(mid, f64::total_cmp);
+        Some(gate * *median)
+    }
+
+    /// Remembers the score per point of an accepted match for the gate.
+    fn record_score(&mut self, res: &MatchResult, points: usize) {
+        self.scores.push_back(res.score / points as f64);
+        if self.scores.len() > GATE_HISTORY {
+            self.scores.pop_front();
+        }
     }
 
     /// The insertion policy: the first scan, then whenever the pose moved
@@ -408,8 +510,9 @@ impl Odometry {
         let mut matched = None;
         let mut pose = prediction;
         let mut accepted = false;
+        let mut multi_start = false;
         if !self.grid().is_empty() && !points.is_empty() {
-            let (mut res, mut ok) = self.match_from(&points, prediction)?;
+            let mut best = self.match_from(&points, prediction)?;
             // Odometry can stall and then jump (dropped messages): when the
             // match from its prior fails, or the two priors disagree by the
             // prior gap, also match from the constant-velocity prior and keep
@@ -419,21 +522,26 @@ impl Odometry {
                 d.x.hypot(d.y) >= self.config.prior_gap_distance
                     || d.theta.abs() >= self.config.prior_gap_angle
             };
-            if let Some(alt) = cv.filter(|&c| c != prediction && (!ok || gap(c))) {
-                let (res2, ok2) = self.match_from(&points, alt)?;
-                if ok2 && (!ok || res2.score > res.score) {
-                    (res, ok, prediction) = (res2, ok2, alt);
+            if let Some(alt) = cv.filter(|&c| c != prediction && (!best.accepted || gap(c))) {
+                let other = self.match_from(&points, alt)?;
+                if other.accepted && (!best.accepted || other.res.score > best.res.score) {
+                    (best, prediction) = (other, alt);
                 }
             }
-            if ok {
-                pose = res.pose;
+            if best.accepted {
+                pose = best.res.pose;
                 accepted = true;
             }
-            matched = Some(res);
+            multi_start = best.multi_start;
+            matched = Some(best.res);
         }
         let inserted = !points.is_empty() && self.should_insert(pose);
         if inserted {
             self.insert_points(&points, ranges, angles, pose)?;
+        }
+        // Nothing below can fail: the loop changes only now.
+        if let Some(res) = matched.as_ref().filter(|_| accepted) {
+            self.record_score(res, points.len());
         }
         self.poses.push(pose);
         if odom.is_some() {
@@ -444,6 +552,7 @@ impl Odometry {
             prediction,
             matched,
             accepted,
+            multi_start,
             inserted,
             num_points: points.len(),
         })

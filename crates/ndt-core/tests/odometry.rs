@@ -1,4 +1,7 @@
-//! The scan-to-map odometry loop: priors, tracking, memory bound, bad input.
+//! The scan-to-map odometry loop: priors, tracking, memory bound, bad input,
+//! the gate of the rotational multi-start.
+
+mod common;
 
 use ndt_core::{NdtError, Odometry, OdometryConfig, Pose2};
 /// Ranges of a beam fan at `pose` inside the square `[-2, 2]²`.
@@ -142,4 +145,93 @@ fn mapper_behind_the_loop_equals_the_mapper_in_line() {
     assert_eq!(inline.0, behind.0);
     assert_eq!(inline.1, behind.1);
     assert_eq!(inline.2, behind.2);
+}
+
+/// Ranges and angles of a 361-beam, 180° scan of the room of the shared
+/// fixtures at `pose` (5 mm range noise).
+fn room_scan(pose: Pose2, seed: u64) -> (Vec<f64>, Vec<f64>) {
+    let points = common::scan(
+        &common::room(),
+        pose,
+        361,
+        std::f64::consts::PI,
+        0.005,
+        seed,
+    );
+    let ranges = points.iter().map(|p| p[0].hypot(p[1])).collect();
+    let angles = points.iter().map(|p| p[1].atan2(p[0])).collect();
+    (ranges, angles)
+}
+
+/// A loop over a steady run in the room whose odometry turns wrong by
+/// `error` rad at scan 14 (priors never compared); per step the pose, whether
+/// the multi-start ran, and the true pose.
+fn run_with_bad_turn(gate: f64, rotation_search: f64, error: f64) -> Vec<(Pose2, bool, Pose2)> {
+    let config = OdometryConfig {
+        coarse_rotation_gate: gate,
+        prior_gap_distance: f64::INFINITY,
+        prior_gap_angle: f64::INFINITY,
+        insert_distance: 0.05,
+        matcher: ndt_core::MatchOptions {
+            rotation_search,
+            ..OdometryConfig::default().matcher
+        },
+        ..OdometryConfig::default()
+    };
+    let mut odo = Odometry::new(config).unwrap();
+    (0..18u32)
+        .map(|i| {
+            let t = f64::from(i);
+            let truth = Pose2::new(0.02 * t, 0.01 * t, 0.01 * t);
+            let (r, a) = room_scan(truth, u64::from(i));
+            let odom = if i == 14 {
+                Pose2::new(truth.x, truth.y, truth.theta + error)
+            } else {
+                truth
+            };
+            let out = odo.step(&r, &a, Some(odom)).unwrap();
+            (out.pose, out.multi_start, truth)
+        })
+        .collect()
+}
+
+fn close(a: Pose2, b: Pose2) -> bool {
+    let d = a.between(b);
+    d.x.hypot(d.y) < 0.01 && d.theta.abs() < 0.005
+}
+
+#[test]
+fn the_multi_start_runs_only_when_a_match_looks_poor() {
+    // A 1 rad odometry error (a wrong reading at scan 14 spoils the
+    // increments into scans 14 and 15), which Newton alone does not undo in
+    // this room, and a multi-start that reaches it.
+    let (error, search) = (1.0, 1.0);
+    let off = run_with_bad_turn(f64::INFINITY, 0.0, error);
+    assert!(!close(off[14].0, off[14].2), "{:?}", off[14]);
+    assert!(off.iter().all(|s| !s.1));
+    // On every scan: every match (from the second scan) ran it; all found.
+    let always = run_with_bad_turn(f64::INFINITY, search, error);
+    assert!(always[1..].iter().all(|s| s.1));
+    assert!(always.iter().all(|s| close(s.0, s.2)), "{always:?}");
+    // Gated: the first 8 accepted matches ran it, then only the two poor
+    // ones, and every pose is found as with the multi-start everywhere.
+    let gated = run_with_bad_turn(0.8, search, error);
+    let ran: Vec<usize> = (0..gated.len()).filter(|&i| gated[i].1).collect();
+    assert_eq!(ran, vec![1, 2, 3, 4, 5, 6, 7, 8, 14, 15]);
+    assert!(gated.iter().all(|s| close(s.0, s.2)), "{gated:?}");
+}
+
+#[test]
+fn the_gate_must_be_a_fraction_of_at_least_zero() {
+    for bad in [f64::NAN, -0.1] {
+        let config = OdometryConfig {
+            coarse_rotation_gate: bad,
+            ..OdometryConfig::default()
+        };
+        let err = Odometry::new(config).unwrap_err().to_string();
+        assert!(
+            err.starts_with("coarse_rotation_gate: expected a fraction >= 0"),
+            "{err}"
+        );
+    }
 }

@@ -29,6 +29,8 @@ pub struct PyStep {
     #[pyo3(get)]
     accepted: bool,
     #[pyo3(get)]
+    multi_start: bool,
+    #[pyo3(get)]
     inserted: bool,
     #[pyo3(get)]
     converged: bool,
@@ -47,6 +49,7 @@ impl From<StepOutcome> for PyStep {
             prediction: s.prediction.to_array(),
             matched: s.matched.is_some(),
             accepted: s.accepted,
+            multi_start: s.multi_start,
             inserted: s.inserted,
             converged: s.matched.as_ref().is_some_and(|m| m.converged),
             iterations: s.matched.as_ref().map_or(0, |m| m.iterations),
@@ -108,7 +111,8 @@ impl PyOdometry {
         expansion = None, sigma_floor = None, shape_cell = None,
         neighbor_search = None, fuse_minority = None, search_radius = None,
         max_iterations = None, max_step_cells = None, max_step_rotation = None,
-        levels = None, coarse_rotation_search = None, freeze_unconstrained = None, freeze_ratio = None, coarse_model = None,
+        levels = None, coarse_rotation_search = None, coarse_rotation_gate = None,
+        freeze_unconstrained = None, freeze_ratio = None, coarse_model = None,
         outlier_filter = None, edge_removal = None, backshift_rejection = None,
         observation_check = None, radial_confirmation = None, match_filtered_map = None,
         background_mapper = None
@@ -137,6 +141,7 @@ impl PyOdometry {
         max_step_rotation: Option<f64>,
         levels: Option<i64>,
         coarse_rotation_search: Option<f64>,
+        coarse_rotation_gate: Option<f64>,
         freeze_unconstrained: Option<bool>,
         freeze_ratio: Option<f64>,
         coarse_model: Option<bool>,
@@ -192,6 +197,7 @@ impl PyOdometry {
             rotation_step: rotation_step.unwrap_or(d.rotation_step),
             prior_gap_distance: prior_gap_distance.unwrap_or(d.prior_gap_distance),
             prior_gap_angle: prior_gap_angle.unwrap_or(d.prior_gap_angle),
+            coarse_rotation_gate: coarse_rotation_gate.unwrap_or(d.coarse_rotation_gate),
             matcher,
             mapper: ndt_core::MapperOptions {
                 outlier_filter: outlier_filter.unwrap_or(d.mapper.outlier_filter),
@@ -302,6 +308,7 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("max_step_rotation", c.matcher.max_step_rotation)?;
     out.set_item("levels", c.matcher.levels)?;
     out.set_item("coarse_rotation_search", c.matcher.rotation_search)?;
+    out.set_item("coarse_rotation_gate", c.coarse_rotation_gate)?;
     out.set_item("freeze_unconstrained", c.matcher.freeze_unconstrained)?;
     out.set_item("freeze_ratio", c.matcher.freeze_ratio)?;
     out.set_item("coarse_model", c.matcher.coarse_model)?;
