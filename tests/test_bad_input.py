@@ -245,6 +245,12 @@ CASES: list[tuple[str, Callable[[ndtgrid.NdtGrid], Any], type[Exception], str]] 
         "expansion: expected a finite value > 0, got NaN",
     ),
     (
+        "rotation gate NaN",
+        lambda g: g.match(GOOD, POSE, rotation_gate=float("nan")),
+        ValueError,
+        "rotation_gate: expected a score per point >= 0 (inf = the multi-start always), got NaN",
+    ),
+    (
         "radius -1",
         lambda g: g.match(GOOD, POSE, search_radius=-1),
         ValueError,

@@ -99,7 +99,9 @@ pub struct OdometryConfig {
     /// score of eq. (1) per point is below this fraction of the median of
     /// the last [`GATE_HISTORY`] accepted matches' (and for the first
     /// [`GATE_MIN_HISTORY`] accepted matches). `inf` = every scan runs the
-    /// multi-start (no first try); 0 = only after a failed match.
+    /// multi-start (no first try); 0 = only after a failed match. (The
+    /// loop's matches with the multi-start ignore the matcher's own
+    /// [`MatchOptions::rotation_gate`]: this gate decides.)
     ///
     /// 0.8 measured on the five benchmark logs (`benches/rotation_sweep.py`,
     /// BENCHMARK.md, "Speed"): with their odometry, mean relation errors
@@ -407,6 +409,11 @@ impl Odometry {
                 });
             }
         }
+        // The gate above decides: the matcher's own is off for this match.
+        let full = &MatchOptions {
+            rotation_gate: f64::INFINITY,
+            ..*full
+        };
         let res = self.grid().match_scan(points, start, full)?;
         Ok(Attempt {
             accepted: self.passes(&res, points.len()),

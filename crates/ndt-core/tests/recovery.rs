@@ -7,6 +7,11 @@ use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
 fn dense_map(cell: f64) -> NdtGrid {
+    map_with_noise(cell, 0.0)
+}
+
+/// [`dense_map`] from scans with range noise σ = `noise` \[m\].
+fn map_with_noise(cell: f64, noise: f64) -> NdtGrid {
     let walls = common::room();
     let mut grid = NdtGrid::new(cell).unwrap();
     // A few noise-free scans from nearby poses, as a map is built.
@@ -20,7 +25,7 @@ fn dense_map(cell: f64) -> NdtGrid {
     .enumerate()
     {
         let pose = Pose2::new(p.0, p.1, p.2);
-        grid.insert(&common::urg_scan(&walls, pose, 0.0, i as u64), pose)
+        grid.insert(&common::urg_scan(&walls, pose, noise, i as u64), pose)
             .unwrap();
     }
     grid
@@ -127,5 +132,54 @@ fn empty_grid_does_not_converge_and_empty_scan_is_an_error() {
     assert_eq!(
         err.to_string(),
         "points: expected at least one point, got 0"
+    );
+}
+
+/// The rotational multi-start's gate: from a start close enough for Newton
+/// the first stage explains the scan and the turned starts are skipped (the
+/// result of no multi-start, bit for bit); from 0.6 rad off it does not, and
+/// the multi-start runs (the result of the multi-start always) and finds the
+/// pose that Newton alone misses (5 mm range noise, map and scan).
+#[test]
+fn the_rotation_gate_skips_the_multi_start_only_when_the_first_stage_explains_the_scan() {
+    let walls = common::room();
+    let grid = map_with_noise(0.02, 0.005);
+    let truth = Pose2::new(0.12, -0.08, 0.2);
+    let scan = common::urg_scan(&walls, truth, 0.005, 99);
+    let with_gate = |rotation_gate: f64, guess: Pose2| {
+        let options = MatchOptions {
+            rotation_gate,
+            ..MatchOptions::default()
+        };
+        grid.match_scan(&scan, guess, &options).unwrap()
+    };
+    let found = |p: Pose2| {
+        let d = truth.between(p);
+        d.x.hypot(d.y) < 5e-3 && d.theta.abs() < 5e-3
+    };
+    let default_gate = MatchOptions::default().rotation_gate;
+    let near = Pose2::new(truth.x + 0.03, truth.y - 0.02, truth.theta + 0.1);
+    let (never, gated, always) = (
+        with_gate(0.0, near),
+        with_gate(default_gate, near),
+        with_gate(f64::INFINITY, near),
+    );
+    assert!(found(gated.pose) && found(always.pose));
+    assert_eq!(
+        (gated.pose, gated.iterations),
+        (never.pose, never.iterations)
+    );
+    assert!(always.iterations > gated.iterations, "{always:?}");
+    let far = Pose2::new(truth.x + 0.03, truth.y - 0.02, truth.theta + 0.6);
+    let (never, gated, always) = (
+        with_gate(0.0, far),
+        with_gate(default_gate, far),
+        with_gate(f64::INFINITY, far),
+    );
+    assert!(!found(never.pose), "{never:?}");
+    assert!(found(gated.pose), "{gated:?}");
+    assert_eq!(
+        (gated.pose, gated.iterations),
+        (always.pose, always.iterations)
     );
 }

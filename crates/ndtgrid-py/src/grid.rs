@@ -122,7 +122,7 @@ impl PyNdtGrid {
     #[pyo3(name = "match", signature = (
         points, guess, *, expansion = 10.0, sigma_floor = 0.02, shape_cell = 0.32, neighbor_search = true, fuse_minority = true,
         pair_neighbors = false, search_radius = 1, max_iterations = 50, translation_tolerance = 1e-4,
-        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, rotation_search = 0.15, freeze_unconstrained = true, freeze_ratio = 0.1,
+        rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, rotation_search = 0.15, rotation_gate = 0.9, freeze_unconstrained = true, freeze_ratio = 0.1,
         levels = None,
         coarse_model = true,
         expansion_phases = None,
@@ -147,6 +147,7 @@ impl PyNdtGrid {
         max_step_cells: f64,
         max_step_rotation: f64,
         rotation_search: f64,
+        rotation_gate: f64,
         freeze_unconstrained: bool,
         freeze_ratio: f64,
         levels: Option<i64>,
@@ -168,6 +169,7 @@ impl PyNdtGrid {
             max_step_cells,
             max_step_rotation,
             rotation_search,
+            rotation_gate,
             freeze_unconstrained,
             freeze_ratio,
             levels: levels.map(|l| count("levels", l)).transpose()?,
@@ -368,6 +370,7 @@ fn options_dict<'py>(py: Python<'py>, d: &MatchOptions) -> PyResult<Bound<'py, P
     out.set_item("max_step_cells", d.max_step_cells)?;
     out.set_item("max_step_rotation", d.max_step_rotation)?;
     out.set_item("rotation_search", d.rotation_search)?;
+    out.set_item("rotation_gate", d.rotation_gate)?;
     out.set_item("freeze_unconstrained", d.freeze_unconstrained)?;
     out.set_item("freeze_ratio", d.freeze_ratio)?;
     out.set_item("levels", d.levels)?;

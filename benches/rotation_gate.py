@@ -1,0 +1,121 @@
+"""The sweep behind ``MatchOptions::rotation_gate`` (BENCHMARK.md, "Speed").
+
+Over several pyramid levels the matcher's rotational multi-start runs only when the first
+stage's solve from the guess scores below the gate per scan point. For each gate this
+prints the successes of the default 2 cm ``match`` on the sets of
+``benches/sigma_floor.py`` (960 real SICK pairs, 960 held-out SICK pairs, the URG-04LX
+pairs with their peer-consensus reference, the simulated pairs; local and wide starts drawn
+as ``benches/convergence.py`` draws them), and the median time of the scan-to-map match of
+``benches/speed.py`` over the real URG-04LX log for scans of at least 500 points (the
+issue's 0.2 ms target), every gate on the same scans, maps and starts (in an order turned
+by one gate from scan to scan).
+
+Run from the repository root::
+
+    python benches/rotation_gate.py                 # gates inf, 0.95, 0.9, 0.85, 0.8
+    python benches/rotation_gate.py --gates inf 0.9 --pairs 10
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import convergence as cv
+import speed
+from sigma_floor import BENCH_OFFSETS, HELD_OUT_OFFSETS
+
+import ndtgrid
+from ndtgrid.evaluation import pose_error
+
+GATES = (float("inf"), 0.95, 0.9, 0.85, 0.8)
+MIN_POINTS = 500  # the issue's dense URG-04LX scans
+
+
+def successes(pairs: list[cv.Pair], starts: list[np.ndarray], gate: float) -> int:
+    """Starts that end within their pair's tolerance."""
+    ok = 0
+    for pair, deltas in zip(pairs, starts):
+        grid = ndtgrid.NdtGrid(0.02, levels=6)
+        grid.insert(pair.target, np.zeros(3))
+        for d in deltas:
+            pose = grid.match(pair.source, pair.truth + d, rotation_gate=gate).pose
+            et, er = pose_error(pose, pair.truth)
+            ok += et < pair.tol[0] and er < pair.tol[1]
+    return ok
+
+
+def urg_times(gates: list[float], seed: int) -> dict[float, float]:
+    """Median match time [s] per gate over the URG log's scans of >= MIN_POINTS points,
+    each against a map of the previous ``speed.WINDOW`` scans, from one local start."""
+    scans = speed.urg_scans()
+    poses = speed.urg_poses(scans)
+    pts = [s.points(max_range=speed.URG_RANGE) for s in scans]
+    rng = np.random.default_rng(seed)
+    times: dict[float, list[float]] = {g: [] for g in gates}
+    for k in range(speed.WINDOW, len(scans)):
+        if len(pts[k]) < MIN_POINTS:
+            continue
+        grid = ndtgrid.NdtGrid(speed.CELL)
+        for j in range(k - speed.WINDOW, k):
+            grid.insert(pts[j], poses[j])
+        grid.match(pts[k - 1], poses[k - 1])  # build the distributions
+        guess = poses[k] + cv.starts(rng, 1, 0.05, 2.0)[0]
+        # Each scan's matches in a turned order, so no gate always goes first.
+        for i in range(len(gates)):
+            g = gates[(i + k) % len(gates)]
+            gc.disable()
+            t0 = time.perf_counter()
+            grid.match(pts[k], guess, rotation_gate=g)
+            times[g].append(time.perf_counter() - t0)
+            gc.enable()
+    return {g: float(np.median(t)) for g, t in times.items()}
+
+
+def main() -> None:
+    """Run the sweep, print a Markdown table."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--gates", nargs="+", type=float, default=list(GATES))
+    ap.add_argument("--pairs", type=int, default=30, help="pairs per real log and offset")
+    ap.add_argument("--starts", type=int, default=8, help="starts per pair and set")
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args()
+    sets = {
+        "SICK": [p for o in BENCH_OFFSETS for p in cv.real_pairs(args.pairs, o)],
+        "held-out SICK": [p for o in HELD_OUT_OFFSETS for p in cv.real_pairs(args.pairs, o)],
+        "URG-04LX": list(cv.urg_pairs(40)),
+        "simulated": list(cv.sim_pairs(8, args.seed)),
+    }
+    starts = {}
+    for name, pairs in sets.items():
+        rng = np.random.default_rng(args.seed)  # as convergence.py draws them
+        wide = [cv.starts(rng, args.starts, 0.4, 10.0) for _ in pairs]
+        local = [cv.starts(rng, args.starts, 0.05, 2.0) for _ in pairs]
+        starts[name] = (local, wide)
+    names = [n for n in sets if sets[n]]
+    medians = urg_times(args.gates, args.seed + 4)
+    print(
+        "Successes from local / wide starts (of "
+        + ", ".join(f"{n} {len(sets[n]) * args.starts}" for n in names)
+        + f"); median match of URG-04LX scans of >= {MIN_POINTS} points.\n"
+    )
+    print("| gate | " + " | ".join(names) + f" | URG ≥ {MIN_POINTS} points [ms] |")
+    print("|---:|" + "---|" * len(names) + "---:|")
+    for gate in args.gates:
+        cells = [
+            f"{successes(sets[n], starts[n][0], gate)} / {successes(sets[n], starts[n][1], gate)}"
+            for n in names
+        ]
+        row = f"| {gate:g} | " + " | ".join(cells) + f" | {1e3 * medians[gate]:.3f} |"
+        print(row, flush=True)
+
+
+if __name__ == "__main__":
+    main()
