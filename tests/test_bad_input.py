@@ -645,6 +645,10 @@ ODOMETRY_CONFIG_CASES = [
         "prior_gap_distance: expected a value >= 0 (inf = never), got NaN",
     ),
     ({"prior_gap_angle": -1.0}, "prior_gap_angle: expected a value >= 0 (inf = never), got -1"),
+    (
+        {"bootstrap_insertions": -1},
+        "bootstrap_insertions: expected a non-negative integer below 2**32, got -1",
+    ),
     ({"expansion": 0.0}, "expansion: expected a finite value > 0, got 0"),
     ({"search_radius": -1}, "search_radius: expected a non-negative integer below 2**32, got -1"),
     ({"search_radius": 5000}, "search_radius: expected a radius of at most 1000 cells, got 5000"),

@@ -986,6 +986,7 @@ class OdometryLoop:
         insert_angle: float | None = None,
         map_window: int | None = None,
         min_match_ratio: float | None = None,
+        bootstrap_insertions: int | None = None,
         rotation_search: float | None = None,
         rotation_step: float | None = None,
         prior_gap_distance: float | None = None,

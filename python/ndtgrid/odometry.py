@@ -49,6 +49,13 @@ class OdometryConfig:
     min_match_ratio : float, default 0.3
         A match is used when at least this fraction of the scan's valid points found a
         distribution; otherwise the pose is the prediction. In [0, 1].
+    bootstrap_insertions : int, default 2
+        While the map holds fewer than this many inserted scans, a converged match is used
+        even below ``min_match_ratio`` (0: never). A map of one sparse scan leaves most
+        points without a distribution even at the right pose (1-degree SICK beams on 2 cm
+        cells), and without odometry the loop would then never move far enough to insert
+        a second scan: ACES without odometry stayed at the origin with 0 and tracked with
+        2 (``BENCHMARK.md``).
     rotation_search : float, default 0 (off)
         Before matching, the score of eq. (1) is evaluated at the prediction turned by
         ``+-rotation_step, +-2 rotation_step, ...`` up to this [rad], and Newton starts from
@@ -145,6 +152,7 @@ class OdometryConfig:
     insert_angle: float = math.radians(5.0)
     map_window: int = 200
     min_match_ratio: float = 0.3
+    bootstrap_insertions: int = 2
     rotation_search: float = 0.0
     rotation_step: float = math.radians(1.0)
     prior_gap_distance: float = 0.1

@@ -235,3 +235,54 @@ fn the_gate_must_be_a_fraction_of_at_least_zero() {
         );
     }
 }
+
+/// Ranges and angles of a 181-beam, 180° scan (1° beams, as a SICK) of an
+/// 8 m × 5 m hall with a pillar, from `pose` (5 mm range noise): most
+/// points lie alone in their 2 cm cell, with no neighbour to fuse with (a
+/// scan matched against one other pairs about a quarter of its points).
+fn hall_scan(pose: Pose2, seed: u64) -> (Vec<f64>, Vec<f64>) {
+    let mut walls = vec![
+        ([-4.0, -2.5], [4.0, -2.5]),
+        ([4.0, -2.5], [4.0, 2.5]),
+        ([4.0, 2.5], [-4.0, 2.5]),
+        ([-4.0, 2.5], [-4.0, -2.5]),
+    ];
+    walls.extend([
+        ([3.0, 1.0], [3.6, 1.0]),
+        ([3.6, 1.0], [3.6, 1.6]),
+        ([3.6, 1.6], [3.0, 1.6]),
+        ([3.0, 1.6], [3.0, 1.0]),
+    ]);
+    let points = common::scan(&walls, pose, 181, std::f64::consts::PI, 0.005, seed);
+    let ranges = points.iter().map(|p| p[0].hypot(p[1])).collect();
+    let angles = points.iter().map(|p| p[1].atan2(p[0])).collect();
+    (ranges, angles)
+}
+
+#[test]
+fn a_young_sparse_map_accepts_converged_matches_so_the_loop_starts() {
+    let run = |bootstrap_insertions: usize| {
+        let config = OdometryConfig {
+            bootstrap_insertions,
+            ..OdometryConfig::default()
+        };
+        let mut odo = Odometry::new(config).unwrap();
+        let mut worst: f64 = 0.0;
+        for i in 0..40u32 {
+            let truth = Pose2::new(0.03 * f64::from(i), 0.0, 0.0);
+            let (r, a) = hall_scan(truth, u64::from(i));
+            let out = odo.step(&r, &a, None).unwrap();
+            let d = truth.between(out.pose);
+            worst = worst.max(d.x.hypot(d.y));
+        }
+        (worst, odo.insertions())
+    };
+    // Without the rule the first match is refused, the pose stays at the
+    // origin and no second scan is ever inserted.
+    let (stuck_error, stuck_insertions) = run(0);
+    assert_eq!(stuck_insertions, 1);
+    assert!(stuck_error > 1.0, "{stuck_error}");
+    let (error, insertions) = run(2);
+    assert!(insertions >= 10, "{insertions}");
+    assert!(error < 0.02, "{error}");
+}

@@ -106,7 +106,8 @@ impl PyOdometry {
     #[new]
     #[pyo3(signature = (
         cell_size = 0.02, *, min_range = None, max_range = None, insert_distance = None,
-        insert_angle = None, map_window = None, min_match_ratio = None, rotation_search = None,
+        insert_angle = None, map_window = None, min_match_ratio = None, bootstrap_insertions = None,
+        rotation_search = None,
         rotation_step = None, prior_gap_distance = None, prior_gap_angle = None,
         expansion = None, sigma_floor = None, shape_cell = None,
         neighbor_search = None, fuse_minority = None, search_radius = None,
@@ -126,6 +127,7 @@ impl PyOdometry {
         insert_angle: Option<f64>,
         map_window: Option<i64>,
         min_match_ratio: Option<f64>,
+        bootstrap_insertions: Option<i64>,
         rotation_search: Option<f64>,
         rotation_step: Option<f64>,
         prior_gap_distance: Option<f64>,
@@ -193,6 +195,10 @@ impl PyOdometry {
             insert_angle: insert_angle.unwrap_or(d.insert_angle),
             map_window: window,
             min_match_ratio: min_match_ratio.unwrap_or(d.min_match_ratio),
+            bootstrap_insertions: bootstrap_insertions
+                .map(|b| count("bootstrap_insertions", b))
+                .transpose()?
+                .map_or(d.bootstrap_insertions, |b| b as usize),
             rotation_search: rotation_search.unwrap_or(d.rotation_search),
             rotation_step: rotation_step.unwrap_or(d.rotation_step),
             prior_gap_distance: prior_gap_distance.unwrap_or(d.prior_gap_distance),
@@ -293,6 +299,7 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("insert_angle", c.insert_angle)?;
     out.set_item("map_window", c.map_window)?;
     out.set_item("min_match_ratio", c.min_match_ratio)?;
+    out.set_item("bootstrap_insertions", c.bootstrap_insertions)?;
     out.set_item("rotation_search", c.rotation_search)?;
     out.set_item("rotation_step", c.rotation_step)?;
     out.set_item("prior_gap_distance", c.prior_gap_distance)?;
