@@ -30,26 +30,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import convergence as cv
 import speed
-from sigma_floor import BENCH_OFFSETS, HELD_OUT_OFFSETS
+from sigma_floor import success_sets, successes
 
 import ndtgrid
-from ndtgrid.evaluation import pose_error
 
 GATES = (float("inf"), 0.95, 0.9, 0.85, 0.8)
 MIN_POINTS = 500  # the issue's dense URG-04LX scans
-
-
-def successes(pairs: list[cv.Pair], starts: list[np.ndarray], gate: float) -> int:
-    """Starts that end within their pair's tolerance."""
-    ok = 0
-    for pair, deltas in zip(pairs, starts):
-        grid = ndtgrid.NdtGrid(0.02, levels=6)
-        grid.insert(pair.target, np.zeros(3))
-        for d in deltas:
-            pose = grid.match(pair.source, pair.truth + d, rotation_gate=gate).pose
-            et, er = pose_error(pose, pair.truth)
-            ok += et < pair.tol[0] and er < pair.tol[1]
-    return ok
 
 
 def urg_times(gates: list[float], seed: int) -> dict[float, float]:
@@ -87,19 +73,8 @@ def main() -> None:
     ap.add_argument("--starts", type=int, default=8, help="starts per pair and set")
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
-    sets = {
-        "SICK": [p for o in BENCH_OFFSETS for p in cv.real_pairs(args.pairs, o)],
-        "held-out SICK": [p for o in HELD_OUT_OFFSETS for p in cv.real_pairs(args.pairs, o)],
-        "URG-04LX": list(cv.urg_pairs(40)),
-        "simulated": list(cv.sim_pairs(8, args.seed)),
-    }
-    starts = {}
-    for name, pairs in sets.items():
-        rng = np.random.default_rng(args.seed)  # as convergence.py draws them
-        wide = [cv.starts(rng, args.starts, 0.4, 10.0) for _ in pairs]
-        local = [cv.starts(rng, args.starts, 0.05, 2.0) for _ in pairs]
-        starts[name] = (local, wide)
-    names = [n for n in sets if sets[n]]
+    sets, starts = success_sets(args.pairs, args.starts, args.seed)
+    names = list(sets)
     medians = urg_times(args.gates, args.seed + 4)
     print(
         "Successes from local / wide starts (of "
@@ -110,7 +85,8 @@ def main() -> None:
     print("|---:|" + "---|" * len(names) + "---:|")
     for gate in args.gates:
         cells = [
-            f"{successes(sets[n], starts[n][0], gate)} / {successes(sets[n], starts[n][1], gate)}"
+            f"{successes(sets[n], starts[n][0], rotation_gate=gate)} / "
+            f"{successes(sets[n], starts[n][1], rotation_gate=gate)}"
             for n in names
         ]
         row = f"| {gate:g} | " + " | ".join(cells) + f" | {1e3 * medians[gate]:.3f} |"

@@ -29,18 +29,45 @@ BENCH_OFFSETS = tuple(k / 8 for k in range(8))
 HELD_OUT_OFFSETS = tuple(k / 8 + 1 / 16 for k in range(8))
 
 
-def success(pairs: list[cv.Pair], starts: list[np.ndarray], floor: float) -> float:
-    """Percentage of starts that end within the pair's tolerance."""
+def successes(pairs: list[cv.Pair], starts: list[np.ndarray], **options: float) -> int:
+    """Starts that end within their pair's tolerance, matched with ``options``."""
     ok = 0
     for pair, deltas in zip(pairs, starts):
         grid = ndtgrid.NdtGrid(0.02, levels=6)
         grid.insert(pair.target, np.zeros(3))
         for d in deltas:
-            et, er = pose_error(
-                grid.match(pair.source, pair.truth + d, sigma_floor=floor).pose, pair.truth
-            )
+            pose = grid.match(pair.source, pair.truth + d, **options).pose
+            et, er = pose_error(pose, pair.truth)
             ok += et < pair.tol[0] and er < pair.tol[1]
+    return ok
+
+
+def success(pairs: list[cv.Pair], starts: list[np.ndarray], floor: float) -> float:
+    """Percentage of starts that end within the pair's tolerance."""
+    ok = successes(pairs, starts, sigma_floor=floor)
     return 100.0 * ok / max(1, sum(len(s) for s in starts))
+
+
+Sets = dict[str, list[cv.Pair]]
+Starts = dict[str, tuple[list[np.ndarray], list[np.ndarray]]]
+
+
+def success_sets(pairs: int, starts: int, seed: int) -> tuple[Sets, Starts]:
+    """The four sets (``pairs`` per real log and offset) and their local and wide starts
+    (``starts`` per pair, drawn per set as ``benches/convergence.py`` draws them)."""
+    sets = {
+        "SICK pairs": [p for o in BENCH_OFFSETS for p in cv.real_pairs(pairs, o)],
+        "held-out SICK pairs": [p for o in HELD_OUT_OFFSETS for p in cv.real_pairs(pairs, o)],
+        "URG-04LX pairs": list(cv.urg_pairs(40)),
+        "simulated pairs": list(cv.sim_pairs(8, seed)),
+    }
+    drawn = {}
+    for name, set_pairs in sets.items():
+        rng = np.random.default_rng(seed)  # as convergence.py draws them
+        wide = [cv.starts(rng, starts, 0.4, 10.0) for _ in set_pairs]
+        local = [cv.starts(rng, starts, 0.05, 2.0) for _ in set_pairs]
+        drawn[name] = (local, wide)
+    return {n: p for n, p in sets.items() if p}, drawn
 
 
 def main() -> None:
@@ -50,19 +77,8 @@ def main() -> None:
     ap.add_argument("--starts", type=int, default=8, help="starts per pair and set")
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
-    sets = {
-        "SICK pairs": [p for o in BENCH_OFFSETS for p in cv.real_pairs(args.pairs, o)],
-        "held-out SICK pairs": [p for o in HELD_OUT_OFFSETS for p in cv.real_pairs(args.pairs, o)],
-        "URG-04LX pairs": list(cv.urg_pairs(40)),
-        "simulated pairs": list(cv.sim_pairs(8, args.seed)),
-    }
-    starts = {}
-    for name, pairs in sets.items():
-        rng = np.random.default_rng(args.seed)  # as convergence.py draws them
-        wide = [cv.starts(rng, args.starts, 0.4, 10.0) for _ in pairs]
-        local = [cv.starts(rng, args.starts, 0.05, 2.0) for _ in pairs]
-        starts[name] = (local, wide)
-    names = [n for n in sets if sets[n]]
+    sets, starts = success_sets(args.pairs, args.starts, args.seed)
+    names = list(sets)
     print("| σ floor | " + " | ".join(f"{n} ({len(sets[n])})" for n in names) + " |")
     print("|---|" + "---|" * len(names))
     for floor in FLOORS:
