@@ -97,6 +97,7 @@ def test_multi_start_runs_on_every_scan_or_behind_the_gate() -> None:
             step = odo.last_step
             assert step is not None
             flags.append(step.multi_start)
+            assert f"multi_start={step.multi_start}," in repr(step)
         ran[gate] = flags
         est = np.array([se2.between(odo.poses[0], p) for p in odo.poses])
         ref = np.array([se2.between(truth[0], p) for p in truth])

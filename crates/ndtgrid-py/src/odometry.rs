@@ -77,9 +77,10 @@ impl PyStep {
         let [x, y, t] = self.pose;
         let b = |v: bool| if v { "True" } else { "False" };
         format!(
-            "OdometryStep(pose=[{x:.6}, {y:.6}, {t:.6}], accepted={}, inserted={}, \
-             converged={}, iterations={}, num_matched={}, num_points={})",
+            "OdometryStep(pose=[{x:.6}, {y:.6}, {t:.6}], accepted={}, multi_start={}, \
+             inserted={}, converged={}, iterations={}, num_matched={}, num_points={})",
             b(self.accepted),
+            b(self.multi_start),
             b(self.inserted),
             b(self.converged),
             self.iterations,
