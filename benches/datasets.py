@@ -104,7 +104,7 @@ class GicpOdometry:
         config: ndtgrid.OdometryConfig,
         downsample: float = 0.01,
     ):
-        import small_gicp
+        import small_gicp  # type: ignore[import-not-found]
 
         self.sg = small_gicp
         self.maps = [small_gicp.GaussianVoxelMap(v) for v in voxels]
@@ -138,7 +138,9 @@ class GicpOdometry:
             cv = se2.compose(self.poses[-1], se2.between(self.poses[-2], self.poses[-1]))
         elif self.poses:
             cv = self.poses[-1]
-        pred = cv if cv is not None else scan.odom
+        # As ndtgrid.Odometry: the first pose is the odometry pose when given, else the origin.
+        first = scan.odom if scan.odom is not None else np.zeros(3)
+        pred: F64 = cv if cv is not None else first
         if self.poses and self.last_odom is not None and scan.odom is not None:
             pred = se2.compose(self.poses[-1], se2.between(self.last_odom, scan.odom))
         pose = pred
@@ -169,6 +171,26 @@ def run_peer(scans: list[Scan], voxels: tuple[float, ...], horizon: int, ds: flo
         peer.step(s)
         progress("small_gicp", k, len(scans), start)
     return Run(np.array(peer.poses), time.perf_counter() - start)
+
+
+@dataclass
+class Row:
+    """One log's results for the tables of :func:`main`."""
+
+    label: str
+    scans: int
+    relations: int
+    raw: RelationSummary
+    ours: RelationSummary
+    peer: RelationSummary | None
+    ms_ours: float
+    ms_peer: float
+    rtf: float
+    duration: float
+    read_s: float
+    published: str
+    vs_raw: tuple[float, float, float]
+    vs_peer: tuple[float, float, float] | None
 
 
 def log_duration(name: str, index: ndtgrid.io.BenchmarkIndex, n: int) -> float:
@@ -244,7 +266,7 @@ def main() -> int:
     args = parser.parse_args()
     voxels = tuple(float(v) for v in args.peer_voxels.split(","))
     print(f"machine: {machine()}", file=sys.stderr)
-    rows = []
+    rows: list[Row] = []
     for name in args.datasets:
         stem, label, published = DATASETS[name]
         start = time.perf_counter()
@@ -267,30 +289,30 @@ def main() -> int:
         e_peer = None if r_peer is None else r_peer.summary()
         n = len(scans)
         duration = log_duration(name, index, n)
-        row = {
-            "label": label,
-            "scans": n,
-            "relations": e_ours.n,
-            "raw": e_raw,
-            "ours": e_ours,
-            "peer": e_peer,
-            "ms_ours": 1e3 * ours.seconds / n,
-            "ms_peer": math.nan if peer is None else 1e3 * peer.seconds / n,
-            "rtf": duration / (read_s + ours.seconds),
-            "duration": duration,
-            "read_s": read_s,
-            "published": published,
-            "vs_raw": paired(r_ours.translation, r_raw.translation),
-            "vs_peer": None if r_peer is None else paired(r_ours.translation, r_peer.translation),
-        }
+        row = Row(
+            label=label,
+            scans=n,
+            relations=e_ours.n,
+            raw=e_raw,
+            ours=e_ours,
+            peer=e_peer,
+            ms_ours=1e3 * ours.seconds / n,
+            ms_peer=math.nan if peer is None else 1e3 * peer.seconds / n,
+            rtf=duration / (read_s + ours.seconds),
+            duration=duration,
+            read_s=read_s,
+            published=published,
+            vs_raw=paired(r_ours.translation, r_raw.translation),
+            vs_peer=None if r_peer is None else paired(r_ours.translation, r_peer.translation),
+        )
         rows.append(row)
         print(f"  raw odometry: {e_raw}\n  ndtgrid:      {e_ours}", file=sys.stderr)
         if e_peer is not None:
             print(f"  small_gicp:   {e_peer}", file=sys.stderr)
         span = "unknown (broken timestamps)" if math.isnan(duration) else f"~{duration:.0f} s"
-        rtf = "" if math.isnan(row["rtf"]) else f" = {row['rtf']:.0f}x real time"
+        rtf = "" if math.isnan(row.rtf) else f" = {row.rtf:.0f}x real time"
         print(
-            f"  {row['ms_ours']:.2f} ms/scan; log spans {span}; read + odometry "
+            f"  {row.ms_ours:.2f} ms/scan; log spans {span}; read + odometry "
             f"{read_s + ours.seconds:.1f} s{rtf}",
             file=sys.stderr,
         )
@@ -302,12 +324,12 @@ def main() -> int:
     )
     print("|---|---:|---:|---|---|---|---|---|---|---:|---:|---|")
     for r in rows:
-        peer_t = "-" if r["peer"] is None else fmt(r["peer"])
-        peer_r = "-" if r["peer"] is None else fmt_rot(r["peer"])
+        peer_t = "-" if r.peer is None else fmt(r.peer)
+        peer_r = "-" if r.peer is None else fmt_rot(r.peer)
         print(
-            f"| {r['label']} | {r['scans']} | {r['relations']} | {fmt(r['raw'])} "
-            f"| {fmt(r['ours'])} | {peer_t} | {fmt_rot(r['raw'])} | {fmt_rot(r['ours'])} "
-            f"| {peer_r} | {r['ms_ours']:.2f} | {r['ms_peer']:.2f} | {r['published']} |"
+            f"| {r.label} | {r.scans} | {r.relations} | {fmt(r.raw)} "
+            f"| {fmt(r.ours)} | {peer_t} | {fmt_rot(r.raw)} | {fmt_rot(r.ours)} "
+            f"| {peer_r} | {r.ms_ours:.2f} | {r.ms_peer:.2f} | {r.published} |"
         )
     print(
         "\nPaired differences of the translational error on the same relations, mean and "
@@ -316,18 +338,14 @@ def main() -> int:
     print("| log | ndtgrid - raw odometry [mm] | ndtgrid - small_gicp [mm] |")
     print("|---|---|---|")
     for r in rows:
-        print(f"| {r['label']} | {fmt_paired(r['vs_raw'])} | {fmt_paired(r['vs_peer'])} |")
+        print(f"| {r.label} | {fmt_paired(r.vs_raw)} | {fmt_paired(r.vs_peer)} |")
     print()
     for r in rows:
-        span = (
-            "unknown (broken timestamps)"
-            if math.isnan(r["duration"])
-            else f"~{r['duration']:.0f} s"
-        )
-        rtf = "" if math.isnan(r["duration"]) else f" = {r['rtf']:.0f}x real time"
+        span = "unknown (broken timestamps)" if math.isnan(r.duration) else f"~{r.duration:.0f} s"
+        rtf = "" if math.isnan(r.duration) else f" = {r.rtf:.0f}x real time"
         print(
-            f"- {r['label']}: log spans {span}; reading {r['read_s']:.1f} s + odometry "
-            f"{r['ms_ours'] * r['scans'] / 1e3:.1f} s{rtf}"
+            f"- {r.label}: log spans {span}; reading {r.read_s:.1f} s + odometry "
+            f"{r.ms_ours * r.scans / 1e3:.1f} s{rtf}"
         )
     return 0
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -29,7 +30,7 @@ BENCH_OFFSETS = tuple(k / 8 for k in range(8))
 HELD_OUT_OFFSETS = tuple(k / 8 + 1 / 16 for k in range(8))
 
 
-def successes(pairs: list[cv.Pair], starts: list[np.ndarray], **options: float) -> int:
+def successes(pairs: list[cv.Pair], starts: list[np.ndarray], **options: Any) -> int:
     """Starts that end within their pair's tolerance, matched with ``options``."""
     ok = 0
     for pair, deltas in zip(pairs, starts):
