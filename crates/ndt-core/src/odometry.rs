@@ -121,7 +121,7 @@ pub struct OdometryConfig {
     /// BENCHMARK.md, "Speed"): with their odometry, mean relation errors
     /// equal to those with the multi-start on every scan or lower (MIT
     /// Killian 0.045 m against 0.048 m), in 17 % less time on Intel, with
-    /// 0.3–2.8 % of the scans running the multi-start; without odometry the
+    /// 0.3–1.6 % of the scans running the multi-start; without odometry the
     /// multi-start off altogether let MIT Killian's rotation error reach 57°,
     /// this gate 2.4°.
     pub coarse_rotation_gate: f64,
