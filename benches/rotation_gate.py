@@ -7,8 +7,8 @@ prints the successes of the default 2 cm ``match`` on the sets of
 pairs with their peer-consensus reference, the simulated pairs; local and wide starts drawn
 as ``benches/convergence.py`` draws them), and the median time of the scan-to-map match of
 ``benches/speed.py`` over the real URG-04LX log for scans of at least 500 points (the
-issue's 0.2 ms target), every gate on the same scans, maps and starts (in an order turned
-by one gate from scan to scan).
+issue's 0.2 ms target: its scans, maps and starts, ``speed.urg_log_maps``), every gate on
+the same cases (in an order turned by one gate from scan to scan).
 
 Run from the repository root::
 
@@ -28,38 +28,24 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import convergence as cv
 import speed
 from sigma_floor import success_sets, successes
-
-import ndtgrid
 
 GATES = (float("inf"), 0.95, 0.9, 0.85, 0.8)
 MIN_POINTS = 500  # the issue's dense URG-04LX scans
 
 
 def urg_times(gates: list[float], seed: int) -> dict[float, float]:
-    """Median match time [s] per gate over the URG log's scans of >= MIN_POINTS points,
-    each against a map of the previous ``speed.WINDOW`` scans, from one local start."""
-    scans = speed.urg_scans()
-    poses = speed.urg_poses(scans)
-    pts = [s.points(max_range=speed.URG_RANGE) for s in scans]
-    rng = np.random.default_rng(seed)
+    """Median match time [s] per gate over the URG log's scans of >= MIN_POINTS points:
+    the cases of ``speed.urg_log_maps`` (the same maps and starts as ``speed.py``)."""
     times: dict[float, list[float]] = {g: [] for g in gates}
-    for k in range(speed.WINDOW, len(scans)):
-        if len(pts[k]) < MIN_POINTS:
-            continue
-        grid = ndtgrid.NdtGrid(speed.CELL)
-        for j in range(k - speed.WINDOW, k):
-            grid.insert(pts[j], poses[j])
-        grid.match(pts[k - 1], poses[k - 1])  # build the distributions
-        guess = poses[k] + cv.starts(rng, 1, 0.05, 2.0)[0]
+    for k, (grid, points, guess) in enumerate(speed.urg_log_maps(seed, min_points=MIN_POINTS)):
         # Each scan's matches in a turned order, so no gate always goes first.
         for i in range(len(gates)):
             g = gates[(i + k) % len(gates)]
             gc.disable()
             t0 = time.perf_counter()
-            grid.match(pts[k], guess, rotation_gate=g)
+            grid.match(points, guess, rotation_gate=g)
             times[g].append(time.perf_counter() - t0)
             gc.enable()
     return {g: float(np.median(t)) for g, t in times.items()}

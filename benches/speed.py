@@ -412,27 +412,41 @@ def sim_map_cases(count: int, seed: int) -> list[convergence.Pair]:
     return cases
 
 
-def urg_log_times(args: argparse.Namespace) -> dict[str, Any]:
-    """Our match time over the whole real URG log, binned by the scan's points: each scan
-    against a 2 cm map of the previous ``WINDOW`` scans (at ``ndtgrid.Odometry``'s poses),
-    from one local start around its odometry pose. Time only (no reference needed)."""
+def urg_log_maps(
+    seed: int, step: int = 1, min_points: int = 0
+) -> Iterator[tuple[ndtgrid.NdtGrid, F64, F64]]:
+    """The scan-to-map cases of :func:`urg_log_times`: for every ``step``-th scan of the
+    real URG log with at least ``min_points`` points, a 2 cm map of the previous
+    ``WINDOW`` scans at ``ndtgrid.Odometry``'s poses (distributions built), the scan's
+    points and one local start around its pose. A start is drawn for every scan, kept or
+    not, so a scan's start is the same whatever ``min_points``."""
     scans = urg_scans()
     poses = urg_poses(scans)
     pts = [s.points(max_range=URG_RANGE) for s in scans]
-    rng = np.random.default_rng(args.seed + 4)
-    step = 4 if args.quick else 1
-    npts, times = [], []
+    rng = np.random.default_rng(seed)
     for k in progress(range(WINDOW, len(scans), step), "URG log: map of 20, every scan"):
+        guess = poses[k] + convergence.starts(rng, 1, 0.05, 2.0)[0]
+        if len(pts[k]) < min_points:
+            continue
         grid = ndtgrid.NdtGrid(CELL)
         for j in range(k - WINDOW, k):
             grid.insert(pts[j], poses[j])
         grid.match(pts[k - 1], poses[k - 1])  # build the distributions
-        guess = poses[k] + convergence.starts(rng, 1, 0.05, 2.0)[0]
+        yield grid, pts[k], guess
+
+
+def urg_log_times(args: argparse.Namespace) -> dict[str, Any]:
+    """Our match time over the whole real URG log, binned by the scan's points: each scan
+    against a 2 cm map of the previous ``WINDOW`` scans (at ``ndtgrid.Odometry``'s poses),
+    from one local start around its odometry pose. Time only (no reference needed)."""
+    step = 4 if args.quick else 1
+    npts, times = [], []
+    for grid, points, guess in urg_log_maps(args.seed + 4, step):
         with no_gc():
             t0 = time.perf_counter()
-            grid.match(pts[k], guess)
+            grid.match(points, guess)
             times.append(time.perf_counter() - t0)
-        npts.append(len(pts[k]))
+        npts.append(len(points))
     n, t = np.array(npts), np.array(times)
     out(
         [

@@ -403,13 +403,19 @@ impl Odometry {
         Some(last.compose(self.last_odom?.between(odom?)))
     }
 
-    /// Matches `points` from `prediction` (after the rotation search): first
-    /// without the rotational multi-start when the gate allows, then with it
-    /// when that match looks poor ([`OdometryConfig::coarse_rotation_gate`]).
-    fn match_from(&self, points: &[[f64; 2]], prediction: Pose2) -> Result<Attempt> {
+    /// Matches `points` from `prediction` (after the rotation search): with a
+    /// `bar` ([`Odometry::gate_bar`]) first without the rotational
+    /// multi-start, then with it when that match looks poor
+    /// ([`OdometryConfig::coarse_rotation_gate`]).
+    fn match_from(
+        &self,
+        points: &[[f64; 2]],
+        prediction: Pose2,
+        bar: Option<f64>,
+    ) -> Result<Attempt> {
         let start = self.rotation_start(points, prediction)?;
         let full = &self.config.matcher;
-        if let Some(bar) = self.gate_bar() {
+        if let Some(bar) = bar {
             let quick = MatchOptions {
                 rotation_search: 0.0,
                 ..*full
@@ -456,7 +462,12 @@ impl Odometry {
         {
             return None;
         }
-        let mut recent: Vec<f64> = self.scores.iter().copied().collect();
+        // A copy on the stack: the history is at most GATE_HISTORY long.
+        let mut copy = [0.0; GATE_HISTORY];
+        let recent = &mut copy[..self.scores.len()];
+        for (r, s) in recent.iter_mut().zip(&self.scores) {
+            *r = *s;
+        }
         let mid = recent.len() / 2;
         let (_, median, _) = recent.select_nth_unstable_by(mid, f64::total_cmp);
         Some(gate * *median)
@@ -536,7 +547,9 @@ impl Odometry {
         let mut accepted = false;
         let mut multi_start = false;
         if !self.grid().is_empty() && !points.is_empty() {
-            let mut best = self.match_from(&points, prediction)?;
+            // The same bar for both priors' matches.
+            let bar = self.gate_bar();
+            let mut best = self.match_from(&points, prediction, bar)?;
             // Odometry can stall and then jump (dropped messages): when the
             // match from its prior fails, or the two priors disagree by the
             // prior gap, also match from the constant-velocity prior and keep
@@ -547,7 +560,7 @@ impl Odometry {
                     || d.theta.abs() >= self.config.prior_gap_angle
             };
             if let Some(alt) = cv.filter(|&c| c != prediction && (!best.accepted || gap(c))) {
-                let other = self.match_from(&points, alt)?;
+                let other = self.match_from(&points, alt, bar)?;
                 if other.accepted && (!best.accepted || other.res.score > best.res.score) {
                     (best, prediction) = (other, alt);
                 }
