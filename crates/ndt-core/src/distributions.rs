@@ -5,7 +5,7 @@
 //! ([`crate::shape`]).
 
 use nalgebra::Vector2;
-use rustc_hash::{FxHashMap, FxHashSet};
+use rustc_hash::FxHashSet;
 
 use crate::cell::{CellStats, Gaussian, MIN_POINTS};
 use crate::cellmask::CellMask;
@@ -67,7 +67,7 @@ impl Distributions {
     /// Builds the distributions of all cells; `shape`: the ancestors whose
     /// covariance they take (see [`crate::shape`]), if a shape level applies.
     pub fn build(
-        cells: &FxHashMap<CellKey, CellStats>,
+        cells: &CellTable<CellStats>,
         cell_size: f64,
         level: usize,
         options: DistOptions,
@@ -76,7 +76,7 @@ impl Distributions {
         let store = match shape {
             None => {
                 let mut map = CellTable::with_capacity(cells.len());
-                for &key in cells.keys() {
+                for key in cells.keys() {
                     if let Some(g) = own_distribution(cells, cell_size, options, key) {
                         map.insert(key, Line(g));
                     }
@@ -86,10 +86,10 @@ impl Distributions {
             Some(s) => {
                 let mut store = ShapedStore::with_capacity(cells.len());
                 // Every ancestor's shape once, then every cell.
-                for &at in s.cells().keys() {
+                for at in s.cells().keys() {
                     store.set_ancestor(at, shape_of_ancestor(s, at, options));
                 }
-                for (&key, own) in cells {
+                for (key, own) in cells.iter() {
                     let at = crate::pyramid::coarse_key(key, s.depth());
                     set_cell(&mut store, cells, cell_size, options, at, key, own);
                 }
@@ -101,7 +101,7 @@ impl Distributions {
                 cells
                     .iter()
                     .filter(|(_, s)| s.count < MIN_POINTS)
-                    .map(|(k, _)| *k),
+                    .map(|(k, _)| k),
             )
         } else {
             CellMask::default()
@@ -133,7 +133,7 @@ impl Distributions {
     /// every cell under it again.
     pub fn update(
         &mut self,
-        cells: &FxHashMap<CellKey, CellStats>,
+        cells: &CellTable<CellStats>,
         cell_size: f64,
         touched: &[CellKey],
         shape: Option<Shape<'_>>,
@@ -142,8 +142,9 @@ impl Distributions {
         // before any neighbour is searched (the shaped update does it in its
         // own pass over the touched cells, which reads their sums anyway).
         if self.options.fuse_minority && !matches!(self.store, Store::Shaped(_)) {
+            let mut sums = cells.cursor();
             self.minority
-                .set_each(touched, |key| is_minority(cells.get(&key)));
+                .set_each(touched, |key| is_minority(sums.get(key)));
         }
         let options = self.options;
         let search = Search {
@@ -305,7 +306,7 @@ impl DistLookup for DistCursor<'_> {
 fn update_own(
     map: &mut CellTable<Line>,
     search: Search<'_>,
-    cells: &FxHashMap<CellKey, CellStats>,
+    cells: &CellTable<CellStats>,
     cell_size: f64,
     options: DistOptions,
     touched: &[CellKey],
@@ -368,7 +369,7 @@ fn with_minority_neighbours(
 fn update_shaped(
     store: &mut ShapedStore,
     search: Search<'_>,
-    cells: &FxHashMap<CellKey, CellStats>,
+    cells: &CellTable<CellStats>,
     cell_size: f64,
     options: DistOptions,
     touched: &[CellKey],
@@ -422,8 +423,9 @@ fn update_shaped(
     });
     // The other touched cells: gone, or a new mean under a shape; their
     // minority flags; those to search.
+    let mut sums = cells.cursor();
     for &key in touched {
-        let own = cells.get(&key);
+        let own = sums.get(key);
         let kind = kinds.of(store, ancestor_of(key));
         match (own, kind) {
             (None, _) => store.remove(key),
@@ -479,7 +481,7 @@ impl AncestorKinds<'_> {
 /// says (see [`Ancestor`]).
 fn set_cell(
     store: &mut ShapedStore,
-    cells: &FxHashMap<CellKey, CellStats>,
+    cells: &CellTable<CellStats>,
     cell_size: f64,
     options: DistOptions,
     at: CellKey,
@@ -507,7 +509,7 @@ fn set_shared(store: &mut ShapedStore, cell_size: f64, key: CellKey, own: &CellS
 /// `Some(None)` when it has no distribution.
 fn shape_of_ancestor(s: Shape<'_>, at: CellKey, options: DistOptions) -> Option<Option<Gaussian>> {
     s.cells()
-        .get(&at)
+        .get(at)
         .filter(|a| a.count >= MIN_POINTS)
         .map(|region| Gaussian::shape_of(region, options.sigma_floor, options.expansion))
 }
@@ -516,12 +518,13 @@ fn shape_of_ancestor(s: Shape<'_>, at: CellKey, options: DistOptions) -> Option<
 /// eq. (7) expanded by eq. (8), fused with the neighbours for a minority cell
 /// (§IV-A(3)).
 fn own_distribution(
-    cells: &FxHashMap<CellKey, CellStats>,
+    cells: &CellTable<CellStats>,
     cell_size: f64,
     options: DistOptions,
     key: CellKey,
 ) -> Option<Gaussian> {
-    let own = cells.get(&key)?;
+    let mut cursor = cells.cursor();
+    let own = cursor.get(key)?;
     let centre = key.center(cell_size);
     if own.count >= MIN_POINTS || !options.fuse_minority {
         return Gaussian::from_stats(own, centre, options.sigma_floor, options.expansion);
@@ -531,7 +534,7 @@ fn own_distribution(
     let mut fused = CellStats::default();
     for dy in -1..=1 {
         for dx in -1..=1 {
-            if let Some(s) = cells.get(&key.offset(dx, dy)) {
+            if let Some(s) = cursor.get(key.offset(dx, dy)) {
                 let delta = Vector2::new(-f64::from(dx), -f64::from(dy)) * cell_size;
                 fused.merge(&s.shifted(delta));
             }
@@ -558,7 +561,7 @@ mod tests {
             assert_eq!(kept.len(), built.len(), "level {level}");
             let cells = grid
                 .level(level)
-                .map(|l| l.cells().keys().copied().collect::<Vec<_>>());
+                .map(|l| l.cells().keys().collect::<Vec<_>>());
             for key in cells.unwrap_or_default() {
                 assert_eq!(kept.get(key), built.get(key), "level {level} cell {key:?}");
             }

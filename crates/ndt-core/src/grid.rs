@@ -4,7 +4,6 @@
 use std::sync::{Arc, Mutex, MutexGuard};
 
 use nalgebra::{Matrix2, Vector2};
-use rustc_hash::FxHashMap;
 
 use crate::cell::CellStats;
 use crate::distributions::{DistOptions, Distributions};
@@ -13,6 +12,7 @@ use crate::key::{CellKey, KeyBounds, MAX_INDEX};
 use crate::pyramid::{Level, Pyramid, MAX_LEVELS};
 use crate::se2::Pose2;
 use crate::shape::Shape;
+use crate::table::CellTable;
 
 mod edit;
 
@@ -126,7 +126,7 @@ impl NdtGrid {
         self.pyramid.level(l)
     }
 
-    fn fine(&self) -> &FxHashMap<CellKey, CellStats> {
+    fn fine(&self) -> &CellTable<CellStats> {
         self.pyramid.fine().cells()
     }
 
@@ -163,7 +163,7 @@ impl NdtGrid {
 
     /// The sums of one cell about its centre, if it holds points.
     pub fn stats(&self, key: CellKey) -> Option<&CellStats> {
-        self.fine().get(&key)
+        self.fine().get(key)
     }
 
     /// Every occupied cell with its eq. (6) sums in map coordinates, sorted by
@@ -172,7 +172,7 @@ impl NdtGrid {
         let mut out: Vec<CellRecord> = self
             .fine()
             .iter()
-            .map(|(&key, s)| {
+            .map(|(key, s)| {
                 // Back from "about the centre c" to "about the origin": shift by −c.
                 let abs = s.shifted(-key.center(self.cell_size));
                 CellRecord {
@@ -272,10 +272,9 @@ impl NdtGrid {
     /// prepared distributions with their look-up tables. Divided by
     /// [`NdtGrid::len`], the memory per occupied fine cell.
     pub fn heap_bytes(&self) -> usize {
-        let entry = std::mem::size_of::<(CellKey, CellStats)>();
         let sums: usize = (0..self.levels())
             .filter_map(|l| self.pyramid.level(l))
-            .map(|lv| crate::table::hash_map_bytes(lv.cells().capacity(), entry))
+            .map(|lv| lv.cells().heap_bytes())
             .sum();
         let prepared: usize = self.lock_prepared().iter().map(|d| d.heap_bytes()).sum();
         sums + self.pyramid.occupied().heap_bytes() + prepared
@@ -283,7 +282,7 @@ impl NdtGrid {
 
     /// Keys of every occupied cell, in no particular order.
     pub fn keys(&self) -> impl Iterator<Item = CellKey> + '_ {
-        self.fine().keys().copied()
+        self.fine().keys()
     }
 
     /// The distributions of pyramid level `level` for `options`, built on
@@ -339,7 +338,7 @@ const PROBE_DEPTH: usize = 4;
 /// blocks without visiting their cells.
 #[derive(Debug)]
 pub struct OccupancyProbe<'a> {
-    ancestors: Option<&'a FxHashMap<CellKey, CellStats>>,
+    ancestors: Option<crate::table::Cursor<'a, CellStats>>,
     depth: usize,
     last: Option<(CellKey, bool)>,
 }
@@ -348,20 +347,20 @@ impl OccupancyProbe<'_> {
     /// log2 of the side \[fine cells\] of the blocks [`OccupancyProbe::may_hold`]
     /// answers for as a whole; `None` when it answers `true` for every cell.
     pub fn block_bits(&self) -> Option<u32> {
-        self.ancestors.map(|_| self.depth as u32)
+        self.ancestors.as_ref().map(|_| self.depth as u32)
     }
 
     /// `false` only when no fine cell `key` exists; `true` when it may.
     #[inline]
     pub fn may_hold(&mut self, key: CellKey) -> bool {
-        let Some(cells) = self.ancestors else {
+        let Some(cells) = self.ancestors.as_mut() else {
             return true;
         };
         let at = crate::pyramid::coarse_key(key, self.depth);
         match self.last {
             Some((k, found)) if k == at => found,
             _ => {
-                let found = cells.contains_key(&at);
+                let found = cells.get(at).is_some();
                 self.last = Some((at, found));
                 found
             }
@@ -376,7 +375,7 @@ impl NdtGrid {
         let depth = PROBE_DEPTH.min(self.levels() - 1);
         OccupancyProbe {
             ancestors: (depth > 0)
-                .then(|| self.pyramid.level(depth).map(Level::cells))
+                .then(|| self.pyramid.level(depth).map(|l| l.cells().cursor()))
                 .flatten(),
             depth,
             last: None,

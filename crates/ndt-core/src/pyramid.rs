@@ -4,22 +4,25 @@
 //! stored, and no level is ever rebuilt: every insert adds to all levels.
 
 use nalgebra::Vector2;
-use rustc_hash::FxHashMap;
 
 use crate::cell::CellStats;
 use crate::cellmask::CellMask;
 use crate::key::{CellKey, KeyBounds};
 use crate::scratch::KeyScratch;
+use crate::table::CellTable;
 
 /// Most levels a grid may have (fine level included).
 pub const MAX_LEVELS: usize = 12;
 
 /// One level of the pyramid: cells of `cell_size` metres with their sums
-/// about each cell's centre.
+/// about each cell's centre, in dense tiles ([`CellTable`]): a coarse cell's
+/// 4 children always share a tile of the level below, and a scan's cells
+/// come in runs along its surfaces, so most look-ups of an update skip the
+/// hash.
 #[derive(Debug, Clone)]
 pub struct Level {
     cell_size: f64,
-    cells: FxHashMap<CellKey, CellStats>,
+    cells: CellTable<CellStats>,
 }
 
 impl Level {
@@ -29,7 +32,7 @@ impl Level {
     }
 
     /// The sums of every occupied cell of this level, about each cell's centre.
-    pub fn cells(&self) -> &FxHashMap<CellKey, CellStats> {
+    pub fn cells(&self) -> &CellTable<CellStats> {
         &self.cells
     }
 }
@@ -63,7 +66,7 @@ impl Pyramid {
         let levels = (0..levels.clamp(1, MAX_LEVELS))
             .map(|l| Level {
                 cell_size: cell_size * f64::from(1u32 << l),
-                cells: FxHashMap::default(),
+                cells: CellTable::default(),
             })
             .collect();
         Self {
@@ -124,7 +127,7 @@ impl Pyramid {
         let mut touched = Vec::with_capacity(staged.len());
         let mut run: Option<(CellKey, CellStats)> = None;
         let mut flush = |key: CellKey, stats: &CellStats| {
-            fine.cells.entry(key).or_default().merge(stats);
+            fine.cells.get_or_default(key).merge(stats);
             if seen.insert(key) {
                 touched.push(key);
             }
@@ -178,6 +181,8 @@ impl Pyramid {
             }
             let (below, above) = self.levels.split_at_mut(l);
             let (lower, upper) = (&below[l - 1], &mut above[0]);
+            // The 4 children of a parent share a tile: one tile look-up at most.
+            let mut children = lower.cells.cursor();
             for &parent in &changed {
                 let mut sum = CellStats::default();
                 for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
@@ -185,14 +190,14 @@ impl Pyramid {
                         ix: parent.ix * 2 + dx,
                         iy: parent.iy * 2 + dy,
                     };
-                    if let Some(s) = lower.cells.get(&child) {
+                    if let Some(s) = children.get(child) {
                         // Children's sums are about their own centres.
                         let delta = parent.center(upper.cell_size) - child.center(lower.cell_size);
                         sum.merge(&s.shifted(delta));
                     }
                 }
                 if sum.count == 0 {
-                    upper.cells.remove(&parent);
+                    upper.cells.remove(parent);
                 } else {
                     upper.cells.insert(parent, sum);
                 }
@@ -213,7 +218,7 @@ impl Pyramid {
         let seen = self.seen.take();
         let mut removed = Vec::new();
         for &key in keys {
-            if seen.insert(key) && self.levels[0].cells.remove(&key).is_some() {
+            if seen.insert(key) && self.levels[0].cells.remove(key).is_some() {
                 removed.push(key);
             }
         }

@@ -15,11 +15,12 @@
 //! ancestor holds fewer than 3 points keep the paper's distribution (eq. 7,
 //! fusion of §IV-A(3)).
 
-use rustc_hash::{FxHashMap, FxHashSet};
+use rustc_hash::FxHashSet;
 
 use crate::cell::CellStats;
 use crate::key::CellKey;
 use crate::pyramid::Level;
+use crate::table::CellTable;
 
 /// The ancestors a level's distributions take their covariance from.
 #[derive(Debug, Clone, Copy)]
@@ -45,7 +46,7 @@ impl<'a> Shape<'a> {
     }
 
     /// The cells of the shape level (sums about their centres).
-    pub fn cells(&self) -> &'a FxHashMap<CellKey, CellStats> {
+    pub fn cells(&self) -> &'a CellTable<CellStats> {
         self.top.cells()
     }
 
@@ -64,7 +65,7 @@ impl<'a> Shape<'a> {
         let mut out = Vec::with_capacity(ancestors.len() * 16);
         let mut stack: Vec<(usize, CellKey)> = Vec::with_capacity(4 * depth + 1);
         for &a in ancestors {
-            if !self.cells().contains_key(&a) {
+            if !self.cells().contains(a) {
                 continue;
             }
             stack.push((depth, a));
@@ -78,14 +79,14 @@ impl<'a> Shape<'a> {
                 };
                 if i == 1 {
                     for c in [(0, 0), (1, 0), (0, 1), (1, 1)].map(child) {
-                        if let Some(stats) = below.cells().get(&c) {
+                        if let Some(stats) = below.cells().get(c) {
                             out.push((a, c, stats));
                         }
                     }
                 } else {
                     // Pushed in reverse: visited (0,0), (1,0), (0,1), (1,1).
                     for c in [(1, 1), (0, 1), (1, 0), (0, 0)].map(child) {
-                        if below.cells().contains_key(&c) {
+                        if below.cells().contains(c) {
                             stack.push((i - 1, c));
                         }
                     }

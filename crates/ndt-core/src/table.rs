@@ -1,6 +1,8 @@
 //! A sparse table of per-cell values stored in dense tiles: the look-up
 //! structure of the matcher's distributions (§III-B keeps cells sparse; the
-//! matcher looks a cell up for every point of every iteration).
+//! matcher looks a cell up for every point of every iteration) and of the
+//! pyramid's sums (an insert re-sums each changed coarse cell from its 4
+//! children, which always share a tile).
 //!
 //! Cells are grouped into square tiles of [`TILE`] × [`TILE`] cells. A hash
 //! map finds a tile by its index; inside a tile a cell is a direct array
@@ -87,6 +89,24 @@ impl<T: Clone> Clone for CellTable<T> {
     }
 }
 
+/// Equal when both hold the same keys with equal values (whatever the order
+/// they were inserted in).
+impl<T: PartialEq> PartialEq for CellTable<T> {
+    fn eq(&self, other: &Self) -> bool {
+        self.len() == other.len() && self.iter().all(|(k, v)| other.get(k) == Some(v))
+    }
+}
+
+impl<T> FromIterator<(CellKey, T)> for CellTable<T> {
+    fn from_iter<I: IntoIterator<Item = (CellKey, T)>>(iter: I) -> Self {
+        let mut table = Self::default();
+        for (key, value) in iter {
+            table.insert(key, value);
+        }
+        table
+    }
+}
+
 impl<T> Default for CellTable<T> {
     fn default() -> Self {
         Self {
@@ -136,6 +156,41 @@ impl<T> CellTable<T> {
         } else {
             Some(&self.values[i as usize])
         }
+    }
+
+    /// `true` when `key` has a value.
+    #[inline]
+    pub fn contains(&self, key: CellKey) -> bool {
+        self.get(key).is_some()
+    }
+
+    /// The value of `key`, set to `T::default()` first when it has none (one
+    /// look-up; runs of calls in one tile skip the hash, as inserts do).
+    #[inline]
+    pub fn get_or_default(&mut self, key: CellKey) -> &mut T
+    where
+        T: Default,
+    {
+        let (t, slot) = self.tile_of(key);
+        let i = match self.slots[t as usize][slot] {
+            EMPTY => {
+                self.push(t, slot, key, T::default());
+                self.values.len() - 1
+            }
+            i => i as usize,
+        };
+        &mut self.values[i]
+    }
+
+    /// Removes every value (keeping the capacity).
+    pub fn clear(&mut self) {
+        self.tiles.clear();
+        self.slots.clear();
+        self.used.clear();
+        self.free_tiles.clear();
+        self.values.clear();
+        self.keys.clear();
+        self.last_insert = None;
     }
 
     /// Sets the value of `key` (replacing any). Unlike
@@ -226,6 +281,12 @@ impl<T> CellTable<T> {
         self.keys.iter().zip(&self.values).map(|(k, v)| (*k, v))
     }
 
+    /// Every key with a value, in no particular order (that of
+    /// [`CellTable::iter`]).
+    pub fn keys(&self) -> impl Iterator<Item = CellKey> + '_ {
+        self.keys.iter().copied()
+    }
+
     /// Bytes this table holds on the heap (capacity, not length): the values,
     /// the tiles and the tile index.
     pub fn heap_bytes(&self) -> usize {
@@ -301,6 +362,10 @@ mod tests {
             };
             if (x >> 60) < 5 {
                 assert_eq!(table.remove(key), naive.remove(&key));
+            } else if (x >> 60) < 7 {
+                // An upsert: adds to the value held, or to 0 when none.
+                *table.get_or_default(key) += 1;
+                *naive.entry(key).or_insert(0) += 1;
             } else if (x >> 60) < 10 {
                 // `replace` gives back what the map held.
                 assert_eq!(table.replace(key, step), naive.insert(key, step));
@@ -318,6 +383,20 @@ mod tests {
                 assert_eq!(cursor.get(key), naive.get(&key));
             }
         }
+        // Equal to a table of the same entries inserted in another order.
+        let mut entries: Vec<_> = naive.iter().map(|(k, v)| (*k, *v)).collect();
+        entries.sort_unstable();
+        let sorted: CellTable<i32> = entries.iter().rev().copied().collect();
+        assert!(sorted == table);
+        let mut keys: Vec<_> = table.keys().collect();
+        keys.sort_unstable();
+        assert_eq!(keys, entries.iter().map(|(k, _)| *k).collect::<Vec<_>>());
+        let mut cleared = sorted;
+        cleared.clear();
+        assert!(cleared.is_empty() && cleared != table);
+        assert_eq!(cleared.get(entries[0].0), None);
+        *cleared.get_or_default(entries[0].0) += 5;
+        assert_eq!(cleared.get(entries[0].0), Some(&5));
         let mut all: Vec<_> = table.iter().map(|(k, v)| (k, *v)).collect();
         all.sort_unstable();
         let mut want: Vec<_> = naive.into_iter().collect();

@@ -187,7 +187,7 @@ fn pyramid_levels_equal_sums_recomputed_from_scratch_after_inserts_and_removals(
         }));
     }
     // Remove every third fine cell, and the points in them from the naive sums.
-    let fine: Vec<CellKey> = grid.level(0).unwrap().cells().keys().copied().collect();
+    let fine: Vec<CellKey> = grid.level(0).unwrap().cells().keys().collect();
     let gone: std::collections::HashSet<CellKey> = fine.iter().copied().step_by(3).collect();
     let gone_list: Vec<CellKey> = gone.iter().copied().collect();
     assert_eq!(grid.remove_cells(&gone_list), gone.len());
@@ -210,7 +210,7 @@ fn pyramid_levels_equal_sums_recomputed_from_scratch_after_inserts_and_removals(
         }
         let level = grid.level(l).unwrap();
         assert_eq!(level.cells().len(), naive.len(), "level {l}");
-        for (key, s) in level.cells() {
+        for (key, s) in level.cells().iter() {
             let (n, m, sxx) = naive[&(i64::from(key.ix), i64::from(key.iy))];
             let abs = s.shifted(-key.center(size));
             assert_eq!(abs.count, n);

@@ -17,8 +17,7 @@ impl NdtGrid {
     /// see [`CellStats`]). [`NdtGrid::from_cell_states`] rebuilds a grid that
     /// is bit for bit the same.
     pub fn cell_states(&self) -> Vec<(CellKey, CellStats)> {
-        let mut out: Vec<(CellKey, CellStats)> =
-            self.fine().iter().map(|(&k, &s)| (k, s)).collect();
+        let mut out: Vec<(CellKey, CellStats)> = self.fine().iter().map(|(k, &s)| (k, s)).collect();
         out.sort_unstable_by_key(|(k, _)| *k);
         out
     }
