@@ -10,7 +10,9 @@
 //! `insert` keeps the prepared distributions of a default match up to date
 //! (as in a SLAM loop), `insert_sums_only` has none prepared (eq. 6 and the
 //! pyramid's sums only), `pyramid_update` is the pyramid's part of that; both
-//! insert into a map that has taken one insert since it was built.
+//! insert into a map that has taken one insert since it was built, and each
+//! timed insert goes to a fresh clone of it; `insert_loop` inserts into one
+//! grid scan after scan, each scan matched first (untimed), as a loop does.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -80,6 +82,45 @@ fn bench_insert_with(c: &mut Criterion, name: &str, prepared: bool) {
                 },
             );
         }
+    }
+    group.finish();
+}
+
+/// Inserts as a SLAM loop makes them, with no clone: one grid takes scans
+/// from a ring of 64 poses through the room, each matched first (untimed,
+/// so the distributions are built and warm, as after the loop's match);
+/// only the insert is timed. The room is bounded, so after the first round
+/// the map keeps its cells and their counts grow.
+fn bench_insert_loop(c: &mut Criterion) {
+    let mut group = c.benchmark_group("insert_loop");
+    for beams in BEAMS {
+        let mut grid = map(beams, 0.02);
+        let ring: Vec<(Pose2, Vec<[f64; 2]>)> = (0..64u32)
+            .map(|i| {
+                let a = f64::from(i) * std::f64::consts::TAU / 64.0;
+                let pose = Pose2::new(1.2 * a.cos(), 0.8 * a.sin(), a + 1.57);
+                (pose, scan(beams, pose, 100 + u64::from(i)))
+            })
+            .collect();
+        let options = MatchOptions::default();
+        let mean = ring.iter().map(|(_, p)| p.len()).sum::<usize>() / ring.len();
+        group.throughput(Throughput::Elements(mean as u64));
+        let mut next = 0usize;
+        group.bench_function(BenchmarkId::new("cell_2cm", beams), |b| {
+            b.iter_custom(|iters| {
+                let mut timed = std::time::Duration::ZERO;
+                for _ in 0..iters {
+                    let (pose, pts) = &ring[next % ring.len()];
+                    next += 1;
+                    let _ = grid.match_scan(pts, *pose, &options);
+                    let t = std::time::Instant::now();
+                    let changed = grid.insert(black_box(pts), *pose);
+                    timed += t.elapsed();
+                    black_box(changed).unwrap_or_else(|e| panic!("{e}"));
+                }
+                timed
+            })
+        });
     }
     group.finish();
 }
@@ -186,6 +227,7 @@ fn bench_large(c: &mut Criterion) {
 criterion_group!(
     benches,
     bench_insert,
+    bench_insert_loop,
     bench_pyramid,
     bench_match,
     bench_large
