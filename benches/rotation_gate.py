@@ -29,7 +29,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import speed
-from sigma_floor import success_sets, successes
+from sigma_floor import parse_with_sets, successes
 
 GATES = (float("inf"), 0.95, 0.9, 0.85, 0.8)
 MIN_POINTS = 500  # the issue's dense URG-04LX scans
@@ -55,11 +55,7 @@ def main() -> None:
     """Run the sweep, print a Markdown table."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--gates", nargs="+", type=float, default=list(GATES))
-    ap.add_argument("--pairs", type=int, default=30, help="pairs per real log and offset")
-    ap.add_argument("--starts", type=int, default=8, help="starts per pair and set")
-    ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
-    sets, starts = success_sets(args.pairs, args.starts, args.seed)
+    args, sets, starts = parse_with_sets(ap)
     names = list(sets)
     medians = urg_times(args.gates, args.seed + 4)
     print(

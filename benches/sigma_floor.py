@@ -71,14 +71,20 @@ def success_sets(pairs: int, starts: int, seed: int) -> tuple[Sets, Starts]:
     return {n: p for n, p in sets.items() if p}, drawn
 
 
-def main() -> None:
-    """Run the sweep."""
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--pairs", type=int, default=30, help="pairs per real log")
+def parse_with_sets(ap: argparse.ArgumentParser) -> tuple[argparse.Namespace, Sets, Starts]:
+    """``ap``'s arguments plus ``--pairs``, ``--starts`` and ``--seed``, parsed, and the
+    :func:`success_sets` they select."""
+    ap.add_argument("--pairs", type=int, default=30, help="pairs per real log and offset")
     ap.add_argument("--starts", type=int, default=8, help="starts per pair and set")
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
     sets, starts = success_sets(args.pairs, args.starts, args.seed)
+    return args, sets, starts
+
+
+def main() -> None:
+    """Run the sweep."""
+    _, sets, starts = parse_with_sets(argparse.ArgumentParser(description=__doc__.splitlines()[0]))
     names = list(sets)
     print("| σ floor | " + " | ".join(f"{n} ({len(sets[n])})" for n in names) + " |")
     print("|---|" + "---|" * len(names))
