@@ -2,9 +2,10 @@
 //! point of a block is paired with its distribution (look-ups, neighbour
 //! search: branchy, short) and the pair's inputs are written column by
 //! column; then the block's arithmetic runs over the columns, [`LANES`] pairs
-//! at a time (`exp`, gradient, Hessian: long dependency chains, no
-//! data-dependent branch), which the compiler turns into SIMD instructions
-//! (AVX2 or AVX-512 where the processor has them, chosen at run time).
+//! at a time (mapping the point by eq. 2, `exp`, gradient, Hessian: long
+//! dependency chains, no data-dependent branch), which the compiler turns
+//! into SIMD instructions (AVX2 or AVX-512 where the processor has them,
+//! chosen at run time).
 //!
 //! Each lane keeps its own running sums (pair `j` of a block goes to lane
 //! `j mod LANES`); [`PairBlock::finish`] adds the lanes in order. The result
@@ -12,47 +13,110 @@
 //! summation order, and [`crate::lanexp`] instead of the C library's `exp`),
 //! but not from one processor to another: no fused multiply-add is used, and
 //! the order is fixed by the pairs alone.
+//!
+//! [`PairBlock`] queues any number of pairs per point (the 3 × 3 pairing of
+//! `MatchOptions::pair_neighbors`); the matcher's usual one pair per point
+//! keeps its columns between evaluations instead ([`crate::pairs`]), with the
+//! same arithmetic ([`add_chunks`]).
 
 use multiversion::multiversion;
-use nalgebra::{Matrix3, Vector2, Vector3};
+use nalgebra::{Matrix3, Vector3};
 
 use crate::cell::Gaussian;
 use crate::lanexp::exp_nonpositive;
 use crate::score::{Order, ScoreTerms};
+use crate::se2::Pose2;
 
 /// Pairs computed side by side (one AVX-512 register of `f64`, two of AVX2).
 pub const LANES: usize = 8;
 /// Chunks of [`LANES`] pairs per block.
 const CHUNKS: usize = 16;
 
-/// The inputs of [`LANES`] pairs, one array per quantity.
-#[derive(Clone, Copy, Default)]
-struct Chunk {
+/// The inputs of [`LANES`] pairs, one array per quantity. A lane with
+/// weight 0 and zeros elsewhere (padding, an unpaired point) adds exact
+/// zeros whatever its point.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Chunk {
     /// Scan-frame point.
-    x: [f64; LANES],
-    y: [f64; LANES],
-    /// `d = x' − q`: mapped point minus the distribution's mean.
-    dx: [f64; LANES],
-    dy: [f64; LANES],
+    pub x: [f64; LANES],
+    pub y: [f64; LANES],
+    /// `q`: the distribution's mean (map frame).
+    pub mx: [f64; LANES],
+    pub my: [f64; LANES],
     /// `C = Σ⁻¹` (symmetric).
-    c00: [f64; LANES],
-    c01: [f64; LANES],
-    c11: [f64; LANES],
+    pub c00: [f64; LANES],
+    pub c01: [f64; LANES],
+    pub c11: [f64; LANES],
     /// Scan points the pair stands for (0 for padding).
-    w: [f64; LANES],
+    pub w: [f64; LANES],
     /// The distribution's surface normal ([`Gaussian::normal`]).
-    nx: [f64; LANES],
-    ny: [f64; LANES],
+    pub nx: [f64; LANES],
+    pub ny: [f64; LANES],
     /// 1 when the distribution is the point's own cell's, else 0.
-    own: [f64; LANES],
+    pub own: [f64; LANES],
+}
+
+impl Chunk {
+    /// Lane `l` takes point `x` (weight `weight`) paired with `dist`.
+    #[inline(always)]
+    pub fn set(&mut self, l: usize, x: [f64; 2], weight: f64, dist: &Gaussian, own: bool) {
+        self.x[l] = x[0];
+        self.y[l] = x[1];
+        self.set_pair(l, weight, dist, own);
+    }
+
+    /// Lane `l` (its point already set) is paired with `dist`.
+    #[inline(always)]
+    pub fn set_pair(&mut self, l: usize, weight: f64, dist: &Gaussian, own: bool) {
+        let m = &dist.inverse;
+        self.mx[l] = dist.mean.x;
+        self.my[l] = dist.mean.y;
+        self.c00[l] = m[(0, 0)];
+        self.c01[l] = m[(0, 1)];
+        self.c11[l] = m[(1, 1)];
+        self.w[l] = weight;
+        self.nx[l] = dist.normal.x;
+        self.ny[l] = dist.normal.y;
+        self.own[l] = if own { 1.0 } else { 0.0 };
+    }
+
+    /// Lane `l` (its point already set) has no pair: it adds exact zeros.
+    #[inline(always)]
+    pub fn clear_pair(&mut self, l: usize) {
+        self.mx[l] = 0.0;
+        self.my[l] = 0.0;
+        self.c00[l] = 0.0;
+        self.c01[l] = 0.0;
+        self.c11[l] = 0.0;
+        self.w[l] = 0.0;
+        self.nx[l] = 0.0;
+        self.ny[l] = 0.0;
+        self.own[l] = 0.0;
+    }
 }
 
 /// Rows of [`LaneSums`].
-const SUMS: usize = 16;
+pub(crate) const SUMS: usize = 16;
 
 /// Running sums per lane: `E`, `g₀…g₂`, `H₀₀ H₀₁ H₀₂ H₁₁ H₁₂ H₂₂`, and the
 /// point-to-plane information of own-cell pairs `A₀₀ A₀₁ A₀₂ A₁₁ A₁₂ A₂₂`.
-type LaneSums = [[f64; LANES]; SUMS];
+pub(crate) type LaneSums = [[f64; LANES]; SUMS];
+
+/// The terms of lane sums `sums`, the lanes added in order; `matched` is the
+/// caller's count of points that had a distribution.
+pub(crate) fn pass_terms(sums: &LaneSums, matched: usize) -> PassTerms {
+    let total = sums.map(|lanes| lanes.iter().fold(0.0, |a, v| a + v));
+    let [e, g0, g1, g2, h00, h01, h02, h11, h12, h22, a00, a01, a02, a11, a12, a22] = total;
+    PassTerms {
+        terms: ScoreTerms {
+            score: e,
+            gradient: Vector3::new(g0, g1, g2),
+            hessian: Matrix3::new(h00, h01, h02, h01, h11, h12, h02, h12, h22),
+            matched,
+        },
+        information: Matrix3::new(a00, a01, a02, a01, a11, a12, a02, a12, a22),
+    }
+}
 
 /// What one pass over a scan's pairs gives.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -88,27 +152,42 @@ impl Default for PairBlock {
 /// What the arithmetic needs besides the pairs.
 #[derive(Clone, Copy)]
 pub struct Scan {
+    /// The pose the points are mapped with (eq. 2).
+    pub pose: Pose2,
     /// `(sin θ, cos θ)` of the pose.
     pub sin_cos: (f64, f64),
     /// How much of the expansion to accumulate.
     pub order: Order,
 }
 
+impl Scan {
+    /// The arithmetic's inputs for `pose`.
+    pub fn new(pose: Pose2, order: Order) -> Self {
+        Self {
+            pose,
+            sin_cos: pose.theta.sin_cos(),
+            order,
+        }
+    }
+
+    /// Adds the terms of `chunks` to `sums` (see [`add_chunks`]).
+    pub(crate) fn add(&self, chunks: &[Chunk], sums: &mut LaneSums) {
+        let (s, c) = self.sin_cos;
+        add_chunks(
+            chunks,
+            [s, c, self.pose.x, self.pose.y],
+            self.order == Order::Derivatives,
+            sums,
+        );
+    }
+}
+
 impl PairBlock {
     /// Queues scan point `x`, standing for `weight` points (1 for a point;
-    /// see [`crate::reduce`]), mapped to `xw = R(θ) x + t` (eq. 2) and paired
-    /// with `dist`, which is its own cell's when `own`; runs the block first
-    /// when it is full.
+    /// see [`crate::reduce`]), paired with `dist`, which is its own cell's
+    /// when `own`; runs the block first when it is full.
     #[inline]
-    pub fn push(
-        &mut self,
-        x: [f64; 2],
-        weight: f64,
-        xw: Vector2<f64>,
-        dist: &Gaussian,
-        own: bool,
-        scan: &Scan,
-    ) {
+    pub fn push(&mut self, x: [f64; 2], weight: f64, dist: &Gaussian, own: bool, scan: &Scan) {
         if self.len == LANES * CHUNKS {
             self.flush(scan);
         }
@@ -116,19 +195,7 @@ impl PairBlock {
         let Some(ch) = self.chunks.get_mut(c) else {
             return;
         };
-        let d = xw - dist.mean;
-        let m = &dist.inverse;
-        ch.x[l] = x[0];
-        ch.y[l] = x[1];
-        ch.dx[l] = d.x;
-        ch.dy[l] = d.y;
-        ch.c00[l] = m[(0, 0)];
-        ch.c01[l] = m[(0, 1)];
-        ch.c11[l] = m[(1, 1)];
-        ch.w[l] = weight;
-        ch.nx[l] = dist.normal.x;
-        ch.ny[l] = dist.normal.y;
-        ch.own[l] = if own { 1.0 } else { 0.0 };
+        ch.set(l, x, weight, dist, own);
         self.len += 1;
     }
 
@@ -140,24 +207,11 @@ impl PairBlock {
             for l in self.len % LANES..LANES {
                 last.x[l] = 0.0;
                 last.y[l] = 0.0;
-                last.dx[l] = 0.0;
-                last.dy[l] = 0.0;
-                last.c00[l] = 0.0;
-                last.c01[l] = 0.0;
-                last.c11[l] = 0.0;
-                last.w[l] = 0.0;
-                last.nx[l] = 0.0;
-                last.ny[l] = 0.0;
-                last.own[l] = 0.0;
+                last.clear_pair(l);
             }
         }
         let chunks = self.chunks.get(..used).unwrap_or(&[]);
-        add_chunks(
-            chunks,
-            scan.sin_cos,
-            scan.order == Order::Derivatives,
-            &mut self.sums,
-        );
+        scan.add(chunks, &mut self.sums);
         self.len = 0;
     }
 
@@ -166,31 +220,24 @@ impl PairBlock {
     /// block empty, as new.
     pub fn finish(&mut self, scan: &Scan, matched: usize) -> PassTerms {
         self.flush(scan);
-        let total = self.sums.map(|lanes| lanes.iter().fold(0.0, |a, v| a + v));
+        let terms = pass_terms(&self.sums, matched);
         self.sums = [[0.0; LANES]; SUMS];
-        let [e, g0, g1, g2, h00, h01, h02, h11, h12, h22, a00, a01, a02, a11, a12, a22] = total;
-        PassTerms {
-            terms: ScoreTerms {
-                score: e,
-                gradient: Vector3::new(g0, g1, g2),
-                hessian: Matrix3::new(h00, h01, h02, h01, h11, h12, h02, h12, h22),
-                matched,
-            },
-            information: Matrix3::new(a00, a01, a02, a01, a11, a12, a02, a12, a22),
-        }
+        terms
     }
 }
 
 /// Adds the terms of `chunks` to `sums`, lane by lane: the expressions of
 /// [`crate::score::Accumulator::add`] (eq. 1, 4, 5), with a pair whose term
-/// underflows (or is NaN) adding zeros.
+/// underflows (or is NaN) adding zeros. `pose`: `sin θ, cos θ, tx, ty`; a
+/// point is mapped by eq. (2) with the expression of
+/// [`Pose2::transform_with`] (the same bits).
 #[multiversion(targets(
     "x86_64+avx512f+avx512dq+avx512vl+avx2+fma+avx",
     "x86_64+avx2+fma+avx",
     "aarch64+neon"
 ))]
-fn add_chunks(chunks: &[Chunk], sin_cos: (f64, f64), derivatives: bool, sums: &mut LaneSums) {
-    let (sn, cs) = sin_cos;
+fn add_chunks(chunks: &[Chunk], pose: [f64; 4], derivatives: bool, sums: &mut LaneSums) {
+    let [sn, cs, tx, ty] = pose;
     for ch in chunks {
         let mut s = [0.0; LANES];
         let mut cd0 = [0.0; LANES];
@@ -199,7 +246,10 @@ fn add_chunks(chunks: &[Chunk], sin_cos: (f64, f64), derivatives: bool, sums: &m
         let mut c01 = [0.0; LANES];
         let mut c11 = [0.0; LANES];
         for l in 0..LANES {
-            let (dx, dy) = (ch.dx[l], ch.dy[l]);
+            // eq. (2), then d = x' − q.
+            let (x, y) = (ch.x[l], ch.y[l]);
+            let dx = cs * x - sn * y + tx - ch.mx[l];
+            let dy = sn * x + cs * y + ty - ch.my[l];
             let a0 = ch.c00[l] * dx + ch.c01[l] * dy;
             let a1 = ch.c01[l] * dx + ch.c11[l] * dy;
             let e = dx * a0 + dy * a1;
@@ -261,8 +311,7 @@ fn add_chunks(chunks: &[Chunk], sin_cos: (f64, f64), derivatives: bool, sums: &m
 mod tests {
     use super::*;
     use crate::score::Accumulator;
-    use crate::se2::Pose2;
-    use nalgebra::Matrix2;
+    use nalgebra::{Matrix2, Vector2};
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
 
@@ -298,10 +347,11 @@ mod tests {
             .collect();
         let points: Vec<[f64; 2]> = (0..700).map(|_| [next(), next()]).collect();
         let weights: Vec<f64> = (0..700).map(|_| 1.0 + next()).collect();
-        let sin_cos = 0.3f64.sin_cos();
+        let pose = Pose2::new(0.01, -0.02, 0.3);
+        let sin_cos = pose.theta.sin_cos();
         for order in [Order::Value, Order::Derivatives] {
             for w in [None, Some(weights.as_slice())] {
-                let scan = Scan { sin_cos, order };
+                let scan = Scan::new(pose, order);
                 let mut naive = Accumulator::default();
                 // Σ |term| per entry: the scale of the rounding differences.
                 let mut magnitude = ScoreTerms::default();
@@ -310,7 +360,7 @@ mod tests {
                 let mut own_pairs = Vec::new();
                 for (i, p) in points.iter().enumerate() {
                     let x = Vector2::new(p[0], p[1]);
-                    let xw = Vector2::new(x.x + 0.01, x.y - 0.02);
+                    let xw = pose.transform_with(sin_cos, x);
                     // 1 to MAX_PAIRS_PER_POINT pairs per point.
                     for j in 0..=(i % MAX_PAIRS_PER_POINT) {
                         let g = &dists[(i * 7 + j) % dists.len()];
@@ -322,7 +372,7 @@ mod tests {
                         magnitude.score += one.score.abs();
                         magnitude.gradient += one.gradient.abs();
                         magnitude.hessian += one.hessian.abs();
-                        block.push(*p, wi, xw, g, j == 0, &scan);
+                        block.push(*p, wi, g, j == 0, &scan);
                         if j == 0 {
                             own_pairs.push((x, g));
                         }
@@ -352,7 +402,7 @@ mod tests {
                     // The information of the own-cell pairs only, unweighted.
                     let want = crate::information::point_to_plane_information(
                         own_pairs.iter().map(|&(x, g)| (x, *g)),
-                        Pose2::new(0.0, 0.0, 0.3),
+                        pose,
                     );
                     let scale = want.abs().max();
                     assert!(
@@ -383,30 +433,20 @@ mod tests {
             inverse: Matrix2::new(1e9, 0.0, 0.0, 1e9),
             ..g
         };
-        let scan = Scan {
-            sin_cos: 0.1f64.sin_cos(),
-            order: Order::Derivatives,
-        };
+        let scan = Scan::new(Pose2::new(0.0, 0.0, 0.1), Order::Derivatives);
         let pts: Vec<[f64; 2]> = (0..2 * LANES).map(|i| [0.01 * i as f64, 0.3]).collect();
         let mut with_bad = PairBlock::default();
         let mut with_zero = PairBlock::default();
         for (i, p) in pts.iter().enumerate() {
-            let xw = Vector2::new(p[0], p[1]);
             match i % 3 {
                 0 => {
-                    with_bad.push(
-                        *p,
-                        1.0,
-                        xw,
-                        if i % 2 == 0 { &huge } else { &far },
-                        true,
-                        &scan,
-                    );
-                    with_zero.push(*p, 0.0, xw, &g, true, &scan);
+                    let bad = if i % 2 == 0 { &huge } else { &far };
+                    with_bad.push(*p, 1.0, bad, true, &scan);
+                    with_zero.push(*p, 0.0, &g, true, &scan);
                 }
                 _ => {
-                    with_bad.push(*p, 1.0, xw, &g, true, &scan);
-                    with_zero.push(*p, 1.0, xw, &g, true, &scan);
+                    with_bad.push(*p, 1.0, &g, true, &scan);
+                    with_zero.push(*p, 1.0, &g, true, &scan);
                 }
             }
         }

@@ -135,11 +135,6 @@ impl NdtGrid {
         self.cell_size
     }
 
-    /// 1 / cell size \[1/m\].
-    pub(crate) fn inv_cell_size(&self) -> f64 {
-        self.inv_cell_size
-    }
-
     /// Number of cells holding at least one point.
     pub fn len(&self) -> usize {
         self.fine().len()

@@ -37,6 +37,7 @@ pub mod matcher;
 pub mod memo;
 pub mod neighbor;
 pub mod odometry;
+pub mod pairs;
 pub mod persist;
 pub mod pyramid;
 pub mod quadratic;

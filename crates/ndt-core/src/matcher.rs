@@ -15,6 +15,7 @@ use crate::information::{own_cell_pairs, point_to_plane_information};
 use crate::key::CellKey;
 use crate::memo::LevelMemo;
 use crate::neighbor::nearest_in_rings_with;
+use crate::pairs::ScanPairs;
 use crate::quadratic::QuadraticModel;
 use crate::reduce::voxel_runs;
 use crate::score::{Order, ScoreTerms};
@@ -341,28 +342,127 @@ pub struct MatchResult {
     pub unconstrained: Vec<[f64; 3]>,
 }
 
-/// The distribution a map-frame point is paired with: its own cell's
-/// (`true`), else (with neighbour search) the nearest one found ring by ring.
-#[inline]
-fn pair<L: DistLookup>(
-    cursor: &mut L,
-    xw: Vector2<f64>,
-    inv_cell: f64,
-    options: &MatchOptions,
-) -> Option<(L::Dist, bool)> {
-    let key = CellKey::of(xw, inv_cell)?;
-    match cursor.get(key) {
-        Some(g) => Some((g, true)),
-        None if options.neighbor_search => {
-            nearest_in_rings_with(cursor, xw, key, options.search_radius).map(|g| (g, false))
+/// Levels whose pairs a match keeps at once ([`MatchPairs`]): a stage
+/// scores its own level and, at its start and for the final pose, the next
+/// coarser one.
+const KEPT_LEVELS: usize = 2;
+
+/// The pairs of one set of (weighted) points kept during one match, for the
+/// last [`KEPT_LEVELS`] levels evaluated ([`crate::pairs`]): so that each
+/// evaluation looks up only the points that changed cell. With
+/// [`MatchOptions::parallel`] and a large scan they are kept in chunks of
+/// [`PARALLEL_CHUNK`] points, evaluated on all cores and summed in order.
+struct MatchPairs<'a> {
+    points: &'a [[f64; 2]],
+    weights: Option<&'a [f64]>,
+    parallel: bool,
+    kept: Vec<(usize, Vec<ScanPairs<'a>>)>,
+}
+
+impl<'a> MatchPairs<'a> {
+    fn new(points: &'a [[f64; 2]], weights: Option<&'a [f64]>, options: &MatchOptions) -> Self {
+        Self {
+            points,
+            weights,
+            parallel: options.parallel && points.len() >= PARALLEL_MIN_POINTS,
+            kept: Vec::with_capacity(KEPT_LEVELS),
         }
-        None => None,
+    }
+
+    /// The kept pairs of `level`: those kept, else the coarsest level's
+    /// (coarse to fine, it is done with), else new ones.
+    fn level(&mut self, level: usize) -> &mut Vec<ScanPairs<'a>> {
+        let at = match self.kept.iter().position(|(l, _)| *l == level) {
+            Some(at) => at,
+            None if self.kept.len() >= KEPT_LEVELS => {
+                let coarsest = (0..self.kept.len())
+                    .max_by_key(|&i| self.kept.get(i).map_or(0, |k| k.0))
+                    .unwrap_or(0);
+                if let Some(k) = self.kept.get_mut(coarsest) {
+                    k.0 = level;
+                }
+                coarsest
+            }
+            None => {
+                let chunk = if self.parallel {
+                    PARALLEL_CHUNK
+                } else {
+                    self.points.len().max(1)
+                };
+                let segments = self
+                    .points
+                    .chunks(chunk)
+                    .enumerate()
+                    .map(|(i, pts)| {
+                        let w = self
+                            .weights
+                            .and_then(|w| w.get(i * chunk..i * chunk + pts.len()));
+                        ScanPairs::new(pts, w)
+                    })
+                    .collect();
+                self.kept.push((level, segments));
+                self.kept.len() - 1
+            }
+        };
+        let len = self.kept.len();
+        &mut self.kept[at.min(len - 1)].1
+    }
+
+    /// Score terms of the points at `pose` on `dists`' level (see
+    /// [`crate::pairs::ScanPairs::evaluate`]; with
+    /// [`MatchOptions::pair_neighbors`], [`evaluate_block`]).
+    fn evaluate(
+        &mut self,
+        dists: &Distributions,
+        pose: Pose2,
+        options: &MatchOptions,
+        order: Order,
+    ) -> PassTerms {
+        let inv_cell = 1.0 / dists.cell_size();
+        if options.pair_neighbors {
+            return evaluate_block(
+                dists,
+                self.points,
+                self.weights,
+                pose,
+                inv_cell,
+                options,
+                order,
+            );
+        }
+        let radius = options.neighbor_search.then_some(options.search_radius);
+        let segments = self.level(dists.level());
+        if let [one] = segments.as_mut_slice() {
+            return one.evaluate(dists, pose, inv_cell, radius, order);
+        }
+        use rayon::prelude::*;
+        let parts: Vec<PassTerms> = segments
+            .par_iter_mut()
+            .map(|s| s.evaluate(dists, pose, inv_cell, radius, order))
+            .collect();
+        sum_parts(&parts)
     }
 }
 
-/// Score terms of the whole scan at `pose`: with [`MatchOptions::parallel`]
-/// and a large scan, chunk by chunk on all cores (see there).
-pub(crate) fn evaluate(
+/// The terms of disjoint parts of a scan, summed in order.
+fn sum_parts(parts: &[PassTerms]) -> PassTerms {
+    let mut total = PassTerms {
+        terms: ScoreTerms::default(),
+        information: Matrix3::zeros(),
+    };
+    for t in parts {
+        total.terms.add_terms(&t.terms);
+        total.terms.matched += t.terms.matched; // disjoint points
+        total.information += t.information;
+    }
+    total
+}
+
+/// Score terms of the whole scan at `pose` with every point scored against
+/// the 3×3 block of cells around it ([`MatchOptions::pair_neighbors`]):
+/// with [`MatchOptions::parallel`] and a large scan, chunk by chunk on all
+/// cores (see there).
+fn evaluate_block(
     dists: &Distributions,
     points: &[[f64; 2]],
     weights: Option<&[f64]>,
@@ -372,7 +472,7 @@ pub(crate) fn evaluate(
     order: Order,
 ) -> PassTerms {
     if !options.parallel || points.len() < PARALLEL_MIN_POINTS {
-        return evaluate_serial(dists, points, weights, pose, inv_cell, options, order);
+        return evaluate_block_serial(dists, points, weights, pose, inv_cell, options, order);
     }
     use rayon::prelude::*;
     let parts: Vec<PassTerms> = points
@@ -381,23 +481,14 @@ pub(crate) fn evaluate(
         .map(|(i, chunk)| {
             let w =
                 weights.and_then(|w| w.get(i * PARALLEL_CHUNK..i * PARALLEL_CHUNK + chunk.len()));
-            evaluate_serial(dists, chunk, w, pose, inv_cell, options, order)
+            evaluate_block_serial(dists, chunk, w, pose, inv_cell, options, order)
         })
         .collect();
-    let mut total = PassTerms {
-        terms: ScoreTerms::default(),
-        information: Matrix3::zeros(),
-    };
-    for t in &parts {
-        total.terms.add_terms(&t.terms);
-        total.terms.matched += t.terms.matched; // disjoint points
-        total.information += t.information;
-    }
-    total
+    sum_parts(&parts)
 }
 
-/// [`evaluate`] on one thread.
-fn evaluate_serial(
+/// [`evaluate_block`] on one thread.
+fn evaluate_block_serial(
     dists: &Distributions,
     points: &[[f64; 2]],
     weights: Option<&[f64]>,
@@ -416,8 +507,8 @@ fn evaluate_serial(
     })
 }
 
-/// The arguments of [`evaluate_serial`], run with the distributions' reader
-/// of whichever kind (see [`Distributions::visit`]).
+/// The arguments of [`evaluate_block_serial`], run with the distributions'
+/// reader of whichever kind (see [`Distributions::visit`]).
 struct Evaluation<'a> {
     points: &'a [[f64; 2]],
     weights: Option<&'a [f64]>,
@@ -433,50 +524,47 @@ impl CursorVisitor for Evaluation<'_> {
     fn visit<L: DistLookup>(self, mut cursor: L) -> PassTerms {
         let (pose, inv_cell, options, weights) =
             (self.pose, self.inv_cell, self.options, self.weights);
-        let sin_cos = pose.theta.sin_cos();
-        let scan = Scan {
-            sin_cos,
-            order: self.order,
-        };
+        let scan = Scan::new(pose, self.order);
         let mut matched = 0;
         let mut block = PairBlock::default();
         for (i, p) in self.points.iter().enumerate() {
             let w = weights.and_then(|w| w.get(i)).copied().unwrap_or(1.0);
-            let xw = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
-            if options.pair_neighbors {
-                let Some(key) = CellKey::of(xw, inv_cell) else {
-                    continue;
-                };
-                let mut any = false;
-                for dy in -1..=1 {
-                    for dx in -1..=1 {
-                        if let Some(g) = cursor.get(key.offset(dx, dy)) {
-                            block.push(*p, w, xw, g.borrow(), dx == 0 && dy == 0, &scan);
-                            any = true;
-                        }
+            let xw = pose.transform_with(scan.sin_cos, Vector2::new(p[0], p[1]));
+            let Some(key) = CellKey::of(xw, inv_cell) else {
+                continue;
+            };
+            let mut any = false;
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    if let Some(g) = cursor.get(key.offset(dx, dy)) {
+                        block.push(*p, w, g.borrow(), dx == 0 && dy == 0, &scan);
+                        any = true;
                     }
                 }
-                if any {
-                    matched += 1;
-                    continue;
-                }
             }
-            if let Some((g, own)) = pair(&mut cursor, xw, inv_cell, options) {
-                block.push(*p, w, xw, g.borrow(), own, &scan);
+            if any {
                 matched += 1;
+                continue;
+            }
+            if options.neighbor_search {
+                if let Some(g) = nearest_in_rings_with(&mut cursor, xw, key, options.search_radius)
+                {
+                    block.push(*p, w, g.borrow(), false, &scan);
+                    matched += 1;
+                }
             }
         }
         block.finish(&scan, matched)
     }
 }
 
-/// Score terms of (weighted) points at `pose` summed over the pyramid levels
-/// of one coarse-to-fine stage (see [`LEVEL_WINDOW`]); with a `memo`, each
-/// level's terms are taken from it when computed there before, and recorded.
+/// Score terms of (weighted) points (those of `pairs`) at `pose` summed
+/// over the pyramid levels of one coarse-to-fine stage (see
+/// [`LEVEL_WINDOW`]); with a `memo`, each level's terms are taken from it
+/// when computed there before, and recorded.
 fn stack_terms(
     stack: &[(usize, Arc<Distributions>)],
-    points: &[[f64; 2]],
-    weights: Option<&[f64]>,
+    pairs: &mut MatchPairs<'_>,
     pose: Pose2,
     options: &MatchOptions,
     order: Order,
@@ -485,17 +573,7 @@ fn stack_terms(
     let mut total = ScoreTerms::default();
     for (level, d) in stack {
         let known = memo.as_ref().and_then(|m| m.get(*level, pose, order));
-        let t = known.unwrap_or_else(|| {
-            evaluate(
-                d,
-                points,
-                weights,
-                pose,
-                1.0 / d.cell_size(),
-                options,
-                order,
-            )
-        });
+        let t = known.unwrap_or_else(|| pairs.evaluate(d, pose, options, order));
         if known.is_none() {
             if let Some(m) = memo.as_mut() {
                 m.put(*level, pose, order, t);
@@ -512,20 +590,12 @@ fn stack_terms(
 /// (from the memo where computed there before).
 fn exact_terms(
     stack: &[(usize, Arc<Distributions>)],
-    points: &[[f64; 2]],
+    pairs: &mut MatchPairs<'_>,
     pose: Pose2,
     options: &MatchOptions,
     memo: &mut LevelMemo,
 ) -> ScoreTerms {
-    stack_terms(
-        stack,
-        points,
-        None,
-        pose,
-        options,
-        Order::Derivatives,
-        Some(memo),
-    )
+    stack_terms(stack, pairs, pose, options, Order::Derivatives, Some(memo))
 }
 
 impl NdtGrid {
@@ -589,6 +659,7 @@ impl NdtGrid {
         let mut outcome = None;
         let mut stack: Vec<(usize, Arc<Distributions>)> = Vec::with_capacity(levels);
         let mut memo = LevelMemo::default();
+        let mut pairs = MatchPairs::new(points, None, options);
         for level in (0..levels).rev() {
             let Some(dists) = self.distributions(level, options.dist_options()) else {
                 break;
@@ -616,7 +687,7 @@ impl NdtGrid {
                 [coarse, _] if options.coarse_model => {
                     let terms = exact_terms(
                         std::slice::from_ref(coarse),
-                        points,
+                        &mut pairs,
                         pose,
                         options,
                         &mut memo,
@@ -632,7 +703,7 @@ impl NdtGrid {
                 &stack[..]
             };
             let mut objective = |p: Pose2, order: Order| {
-                let mut t = stack_terms(scored, points, None, p, options, order, Some(&mut memo));
+                let mut t = stack_terms(scored, &mut pairs, p, options, order, Some(&mut memo));
                 if let Some(m) = &model {
                     let coarse = m.terms(p);
                     t.add_terms(&coarse);
@@ -660,21 +731,14 @@ impl NdtGrid {
                     0.0
                 };
                 let few = voxel_runs(points, voxel);
-                let rough = |p: Pose2, order: Order| {
-                    stack_terms(
-                        &stack,
-                        &few.points,
-                        Some(&few.weights),
-                        p,
-                        options,
-                        order,
-                        None,
-                    )
+                let mut few_pairs = MatchPairs::new(&few.points, Some(&few.weights), options);
+                let mut rough = |p: Pose2, order: Order| {
+                    stack_terms(&stack, &mut few_pairs, p, options, order, None)
                 };
                 for sign in [-1.0, 1.0] {
                     let start =
                         Pose2::new(pose.x, pose.y, pose.theta + sign * options.rotation_search);
-                    let landed = minimise(start, &solver, rough);
+                    let landed = minimise(start, &solver, &mut rough);
                     iterations += landed.iterations;
                     if level == 0 {
                         if landed.terms.score > solved.terms.score {
@@ -696,7 +760,7 @@ impl NdtGrid {
             pose = solved.pose;
             if model.is_some() && level == 0 {
                 // The final score and Hessian exactly, both levels scored.
-                solved.terms = exact_terms(&stack, points, pose, options, &mut memo);
+                solved.terms = exact_terms(&stack, &mut pairs, pose, options, &mut memo);
             }
             outcome = Some(solved);
         }
@@ -788,15 +852,8 @@ impl NdtGrid {
         let dists = self
             .distributions(0, options.dist_options())
             .ok_or(NdtError::Empty { what: "levels" })?;
-        Ok(evaluate(
-            &dists,
-            points,
-            None,
-            pose,
-            self.inv_cell_size(),
-            options,
-            order,
-        )
-        .terms)
+        Ok(MatchPairs::new(points, None, options)
+            .evaluate(&dists, pose, options, order)
+            .terms)
     }
 }

@@ -1,0 +1,400 @@
+//! A scan's points paired with one level's distributions, kept from one
+//! evaluation of the score to the next (a correspondence cache).
+//!
+//! Newton's method (§III-A) evaluates eq. (1) and its derivatives (eq. 3–5)
+//! at a sequence of nearby poses, and between two of them most points stay
+//! in their cell, so they pair with the same distribution. [`ScanPairs`]
+//! keeps each point's cell and its pair's inputs in the column layout of
+//! [`crate::batch`] (point `i` in lane `i mod LANES` of chunk `i / LANES`).
+//! An evaluation maps every point (eq. 2) and looks up only those whose cell
+//! changed, and those whose own cell has no distribution: the neighbour
+//! search of §IV-A(1) picks the nearest mean to where the point is, so they
+//! are paired anew every time. The arithmetic then runs over the kept
+//! columns in place, with no copy.
+//!
+//! A kept pair is exactly the pair a fresh look-up gives (the same cell of
+//! the same distributions), and every point has its own lane whether it is
+//! paired or not (an unpaired point weighs 0 and adds exact zeros), so an
+//! evaluation gives the same bits whatever was kept before it.
+
+use std::borrow::Borrow;
+
+use multiversion::multiversion;
+use nalgebra::Vector2;
+
+use crate::batch::{pass_terms, Chunk, LaneSums, PassTerms, Scan, LANES, SUMS};
+use crate::distributions::{CursorVisitor, DistLookup, Distributions};
+use crate::key::{CellKey, MAX_INDEX};
+use crate::neighbor::nearest_in_rings_with;
+use crate::score::Order;
+use crate::se2::Pose2;
+
+/// The cells of one chunk's [`LANES`] points.
+#[derive(Debug, Clone, Copy, Default)]
+struct KeyLanes {
+    ix: [i32; LANES],
+    iy: [i32; LANES],
+}
+
+/// What is known of the pairs of one chunk's points, a bit per lane.
+#[derive(Debug, Clone, Copy, Default)]
+struct Known {
+    /// The lane's own cell (its kept key) has a distribution, which the
+    /// lane holds.
+    own: u8,
+    /// The lane's own cell (its kept key) has none: the lane is paired by
+    /// the neighbour search, anew at every evaluation.
+    searched: u8,
+}
+
+/// The points of a scan (optionally weighted, see [`crate::reduce`]) with
+/// their pairs in one [`Distributions`] (see the module docs).
+#[derive(Debug)]
+pub struct ScanPairs<'a> {
+    points: &'a [[f64; 2]],
+    weights: Option<&'a [f64]>,
+    /// The address of the distributions the kept pairs come from (an
+    /// identity only; they outlive the pairs).
+    source: Option<usize>,
+    chunks: Vec<Chunk>,
+    keys: Vec<KeyLanes>,
+    known: Vec<Known>,
+    /// This evaluation's cells, and per chunk the lanes whose cell exists
+    /// (a point within the grid's index range) and is the kept one.
+    fresh: Vec<KeyLanes>,
+    valid: Vec<u8>,
+    same: Vec<u8>,
+}
+
+impl<'a> ScanPairs<'a> {
+    /// `points` (scan frame \[m\]), each standing for `weights[i]` points (1
+    /// without weights), with nothing paired yet.
+    pub fn new(points: &'a [[f64; 2]], weights: Option<&'a [f64]>) -> Self {
+        let n = points.len().div_ceil(LANES);
+        let mut chunks = vec![Chunk::default(); n];
+        for (ch, pts) in chunks.iter_mut().zip(points.chunks(LANES)) {
+            for (l, p) in pts.iter().enumerate() {
+                ch.x[l] = p[0];
+                ch.y[l] = p[1];
+            }
+        }
+        Self {
+            points,
+            weights,
+            source: None,
+            chunks,
+            keys: vec![KeyLanes::default(); n],
+            known: vec![Known::default(); n],
+            fresh: vec![KeyLanes::default(); n],
+            valid: vec![0; n],
+            same: vec![0; n],
+        }
+    }
+
+    /// Score terms of the points at `pose` against `dists` (cells of
+    /// `1 / inv_cell` m), each paired with its own cell's distribution or,
+    /// when `search_radius` is given and that cell has none, the nearest
+    /// found by [`nearest_in_rings_with`]. Pairs kept from an evaluation
+    /// against other distributions are forgotten first.
+    pub fn evaluate(
+        &mut self,
+        dists: &Distributions,
+        pose: Pose2,
+        inv_cell: f64,
+        search_radius: Option<u32>,
+        order: Order,
+    ) -> PassTerms {
+        let source = std::ptr::from_ref(dists) as usize;
+        if self.source != Some(source) {
+            self.known.fill(Known::default());
+            self.source = Some(source);
+        }
+        let scan = Scan::new(pose, order);
+        let (s, c) = scan.sin_cos;
+        cell_keys(
+            &self.chunks,
+            [s, c, pose.x, pose.y, inv_cell],
+            &self.keys,
+            &mut self.fresh,
+            &mut self.valid,
+            &mut self.same,
+        );
+        let matched = dists.visit(Refresh {
+            pairs: self,
+            scan: &scan,
+            search_radius,
+        });
+        let mut sums: LaneSums = [[0.0; LANES]; SUMS];
+        scan.add(&self.chunks, &mut sums);
+        pass_terms(&sums, matched)
+    }
+}
+
+/// The cell of every point at a pose (`sin θ, cos θ, tx, ty`, then `1 /
+/// cell size`): into `fresh`, with per chunk the lanes whose cell exists
+/// (`valid`: as [`CellKey::of`] gives `Some`, the same index) and the valid
+/// lanes whose cell is the kept one in `kept` (`same`). No branch: the
+/// compiler vectorises it.
+#[multiversion(targets(
+    "x86_64+avx512f+avx512dq+avx512vl+avx2+fma+avx",
+    "x86_64+avx2+fma+avx",
+    "aarch64+neon"
+))]
+fn cell_keys(
+    chunks: &[Chunk],
+    pose: [f64; 5],
+    kept: &[KeyLanes],
+    fresh: &mut [KeyLanes],
+    valid: &mut [u8],
+    same: &mut [u8],
+) {
+    let [sn, cs, tx, ty, inv] = pose;
+    let lim = f64::from(MAX_INDEX);
+    let rows = chunks
+        .iter()
+        .zip(kept)
+        .zip(fresh.iter_mut().zip(valid.iter_mut().zip(same.iter_mut())));
+    for ((ch, kept), (fresh, (valid, same))) in rows {
+        let mut ok = [false; LANES];
+        let mut eq = [false; LANES];
+        for l in 0..LANES {
+            let (x, y) = (ch.x[l], ch.y[l]);
+            // eq. (2) as Pose2::transform_with, then CellKey::of.
+            let vx = (cs * x - sn * y + tx) * inv;
+            let vy = (sn * x + cs * y + ty) * inv;
+            ok[l] = vx >= 1.0 - lim && vx < lim && vy >= 1.0 - lim && vy < lim;
+            let (kx, ky) = (vx as i32, vy as i32);
+            let ix = kx - i32::from(f64::from(kx) > vx);
+            let iy = ky - i32::from(f64::from(ky) > vy);
+            fresh.ix[l] = ix;
+            fresh.iy[l] = iy;
+            eq[l] = ix == kept.ix[l] && iy == kept.iy[l];
+        }
+        let (mut v, mut e) = (0u8, 0u8);
+        for l in 0..LANES {
+            v |= u8::from(ok[l]) << l;
+            e |= u8::from(ok[l] && eq[l]) << l;
+        }
+        *valid = v;
+        *same = e;
+    }
+}
+
+/// One evaluation's pairing, run with the distributions' reader of
+/// whichever kind (see [`Distributions::visit`]): returns the number of
+/// points paired.
+struct Refresh<'p, 'a> {
+    pairs: &'p mut ScanPairs<'a>,
+    scan: &'p Scan,
+    search_radius: Option<u32>,
+}
+
+impl CursorVisitor for Refresh<'_, '_> {
+    type Out = usize;
+
+    fn visit<L: DistLookup>(self, mut cursor: L) -> usize {
+        let ScanPairs {
+            points,
+            weights,
+            chunks,
+            keys,
+            known,
+            fresh,
+            valid,
+            same,
+            ..
+        } = self.pairs;
+        let (pose, sin_cos) = (self.scan.pose, self.scan.sin_cos);
+        let mut matched = 0;
+        let rows = chunks
+            .iter_mut()
+            .zip(keys.iter_mut().zip(known.iter_mut()))
+            .zip(fresh.iter().zip(valid.iter().zip(same.iter())));
+        for (c, ((ch, (kept, known)), (fresh, (&valid, &same)))) in rows.enumerate() {
+            let lanes = points.len().saturating_sub(c * LANES).min(LANES);
+            let all = if lanes == LANES {
+                u8::MAX
+            } else {
+                (1u8 << lanes) - 1
+            };
+            // The lanes whose own pair is kept: nothing to do.
+            let hit = same & known.own;
+            matched += hit.count_ones() as usize;
+            if hit == all {
+                continue;
+            }
+            for l in 0..lanes {
+                let bit = 1u8 << l;
+                if hit & bit != 0 {
+                    continue;
+                }
+                if valid & bit == 0 {
+                    known.own &= !bit;
+                    known.searched &= !bit;
+                    ch.clear_pair(l);
+                    continue;
+                }
+                let i = c * LANES + l;
+                let key = CellKey {
+                    ix: fresh.ix[l],
+                    iy: fresh.iy[l],
+                };
+                let w = weights.and_then(|w| w.get(i)).copied().unwrap_or(1.0);
+                if same & known.searched & bit == 0 {
+                    kept.ix[l] = key.ix;
+                    kept.iy[l] = key.iy;
+                    if let Some(g) = cursor.get(key) {
+                        ch.set_pair(l, w, g.borrow(), true);
+                        known.own |= bit;
+                        known.searched &= !bit;
+                        matched += 1;
+                        continue;
+                    }
+                }
+                known.own &= !bit;
+                known.searched |= bit;
+                let Some(p) = points.get(i) else {
+                    break;
+                };
+                let xw = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
+                match self
+                    .search_radius
+                    .and_then(|r| nearest_in_rings_with(&mut cursor, xw, key, r))
+                {
+                    Some(g) => {
+                        ch.set_pair(l, w, g.borrow(), false);
+                        matched += 1;
+                    }
+                    None => ch.clear_pair(l),
+                }
+            }
+        }
+        matched
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::batch::PairBlock;
+    use crate::distributions::DistOptions;
+    use crate::grid::NdtGrid;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    /// A fresh block of the pairs `pair` gives, point by point in order: the
+    /// reference for the kept pairs (same pairs; lanes by pair, not by point,
+    /// so the sums agree to rounding, not to the bit).
+    fn by_block(
+        dists: &Distributions,
+        points: &[[f64; 2]],
+        weights: Option<&[f64]>,
+        pose: Pose2,
+        radius: Option<u32>,
+        order: Order,
+    ) -> PassTerms {
+        let scan = Scan::new(pose, order);
+        let inv = 1.0 / dists.cell_size();
+        let mut cursor = dists.cursor();
+        let mut block = PairBlock::default();
+        let mut matched = 0;
+        for (i, p) in points.iter().enumerate() {
+            let xw = pose.transform_with(scan.sin_cos, Vector2::new(p[0], p[1]));
+            let Some(key) = CellKey::of(xw, inv) else {
+                continue;
+            };
+            let pair = match cursor.get(key) {
+                Some(g) => Some((g, true)),
+                None => radius
+                    .and_then(|r| nearest_in_rings_with(&mut cursor, xw, key, r))
+                    .map(|g| (g, false)),
+            };
+            if let Some((g, own)) = pair {
+                let w = weights.map_or(1.0, |w| w[i]);
+                block.push(*p, w, &g, own, &scan);
+                matched += 1;
+            }
+        }
+        block.finish(&scan, matched)
+    }
+
+    fn close(a: &PassTerms, b: &PassTerms) -> bool {
+        let t = |p: &PassTerms| {
+            let mut v = vec![p.terms.score];
+            v.extend(p.terms.gradient.iter());
+            v.extend(p.terms.hessian.iter());
+            v.extend(p.information.iter());
+            v
+        };
+        let (x, y) = (t(a), t(b));
+        let scale = x.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+        a.terms.matched == b.terms.matched
+            && x.iter()
+                .zip(&y)
+                .all(|(p, q)| (p - q).abs() <= 1e-12 * scale)
+    }
+
+    /// Along a random walk of poses (points crossing cells, leaving the map,
+    /// with and without the neighbour search, weighted or not, on two
+    /// levels in turn), every evaluation through the kept pairs gives the
+    /// bits of an evaluation with nothing kept, and the pairs a fresh
+    /// point-by-point pairing gives (its sums to rounding).
+    #[test]
+    fn kept_pairs_give_the_bits_of_fresh_ones() {
+        let mut rng = StdRng::seed_from_u64(5);
+        let mut grid = NdtGrid::new(0.02).unwrap();
+        let wall: Vec<[f64; 2]> = (0..400)
+            .map(|i| {
+                let t = f64::from(i) * 0.004;
+                [t, 0.5 + 0.003 * (t * 40.0).sin()]
+            })
+            .chain((0..300).map(|i| [0.2 + 0.0013 * f64::from(i % 7), f64::from(i) * 0.004]))
+            .collect();
+        grid.insert(&wall, Pose2::identity()).unwrap();
+        let options = DistOptions {
+            expansion: 10.0,
+            fuse_minority: true,
+            sigma_floor: 0.005,
+            shape_cell: 0.0,
+        };
+        let levels: Vec<_> = (0..2)
+            .map(|l| grid.distributions(l, options).unwrap())
+            .collect();
+        let points: Vec<[f64; 2]> = (0..203)
+            .map(|i| {
+                let t = f64::from(i) * 0.008;
+                if i % 2 == 0 {
+                    [t, 0.5]
+                } else {
+                    [0.2, t]
+                }
+            })
+            .collect();
+        let weights: Vec<f64> = (0..203).map(|i| 1.0 + f64::from(i % 3)).collect();
+        for (radius, w) in [
+            (Some(1), None),
+            (None, Some(weights.as_slice())),
+            (Some(3), Some(weights.as_slice())),
+        ] {
+            let mut kept = ScanPairs::new(&points, w);
+            let mut pose = Pose2::identity();
+            for step in 0..60 {
+                pose = Pose2::new(
+                    pose.x + rng.random_range(-0.02..0.02),
+                    pose.y + rng.random_range(-0.02..0.02),
+                    pose.theta + rng.random_range(-0.02..0.02),
+                );
+                let d = &levels[(step / 7) % 2];
+                let inv = 1.0 / d.cell_size();
+                for order in [Order::Value, Order::Derivatives] {
+                    let got = kept.evaluate(d, pose, inv, radius, order);
+                    let fresh = ScanPairs::new(&points, w).evaluate(d, pose, inv, radius, order);
+                    assert_eq!(got, fresh, "step {step}");
+                    let want = by_block(d, &points, w, pose, radius, order);
+                    assert!(close(&got, &want), "step {step}: {got:?} vs {want:?}");
+                }
+            }
+        }
+    }
+}
