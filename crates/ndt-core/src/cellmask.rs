@@ -98,7 +98,7 @@ impl CellMask {
     pub fn reader(&self) -> CellMaskReader<'_> {
         CellMaskReader {
             mask: self,
-            last: None,
+            last: [None; 4],
         }
     }
 
@@ -112,28 +112,72 @@ impl CellMask {
     }
 }
 
-/// Reads a [`CellMask`] remembering the last block (a cell's neighbourhood
-/// and a run of cells along a beam mostly lie in one).
+/// Reads a [`CellMask`] remembering the last word read of each parity of
+/// its block index (a cell's neighbourhood, and a run of cells along a
+/// beam, mostly lie in one block, and any 2 × 2 blocks have one of each
+/// parity).
 #[derive(Debug)]
 pub struct CellMaskReader<'a> {
     mask: &'a CellMask,
-    last: Option<((i32, i32), u64)>,
+    last: [Option<((i32, i32), u64)>; 4],
 }
 
 impl CellMaskReader<'_> {
+    /// The word of `block` (0 when the mask has none).
+    #[inline(always)]
+    fn word(&mut self, block: (i32, i32)) -> u64 {
+        let parity = ((block.0 & 1) | ((block.1 & 1) << 1)) as usize;
+        match self.last.get(parity).copied().flatten() {
+            Some((b, w)) if b == block => w,
+            _ => self.find(block, parity),
+        }
+    }
+
+    /// The hashed look-up of a word not remembered.
+    #[inline(never)]
+    fn find(&mut self, block: (i32, i32), parity: usize) -> u64 {
+        let w = self.mask.blocks.get(&block).copied().unwrap_or(0);
+        if let Some(r) = self.last.get_mut(parity) {
+            *r = Some((block, w));
+        }
+        w
+    }
+
     /// `true` when `key` is in the set.
     #[inline]
     pub fn contains(&mut self, key: CellKey) -> bool {
         let (block, bit) = split(key);
-        let word = match self.last {
-            Some((b, w)) if b == block => w,
-            _ => {
-                let w = self.mask.blocks.get(&block).copied().unwrap_or(0);
-                self.last = Some((block, w));
-                w
-            }
-        };
-        word >> bit & 1 == 1
+        self.word(block) >> bit & 1 == 1
+    }
+
+    /// The members of the 3 × 3 block of cells around `key` as 9 bits, bit
+    /// `3 · (dy + 1) + (dx + 1)` for the cell at offset `(dx, dy)`: three
+    /// bits of one word per row, or of two where the row crosses a block
+    /// border.
+    #[inline]
+    pub fn block3(&mut self, key: CellKey) -> u16 {
+        let x0 = key.ix - 1;
+        let (left, right) = (x0 >> BLOCK_BITS, (x0 + 2) >> BLOCK_BITS);
+        let mut bits = 0u16;
+        for r in 0..3 {
+            let y = key.iy + r - 1;
+            let (by, row) = (y >> BLOCK_BITS, (y & MASK) << BLOCK_BITS);
+            let w = self.word((left, by));
+            let three = if left == right {
+                (w >> (row | (x0 & MASK))) & 0b111
+            } else {
+                let w2 = self.word((right, by));
+                let mut three = 0;
+                for c in 0..3 {
+                    let x = x0 + c;
+                    let word = if x >> BLOCK_BITS == left { w } else { w2 };
+                    three |= ((word >> (row | (x & MASK))) & 1) << c;
+                }
+                three
+            };
+            bits |= (three as u16) << (3 * r);
+        }
+        bits
     }
 }
 
@@ -186,11 +230,17 @@ mod tests {
         });
         assert_eq!(each, mask);
         let mut reader = mask.reader();
+        let mut blocks = mask.reader();
+        let minority = |key: CellKey| cells.get(&key).is_some_and(|s| s.count < MIN_POINTS);
         for iy in -22..22 {
             for ix in -22..22 {
                 let key = CellKey { ix, iy };
-                let want = cells.get(&key).is_some_and(|s| s.count < MIN_POINTS);
-                assert_eq!(reader.contains(key), want, "{key:?}");
+                assert_eq!(reader.contains(key), minority(key), "{key:?}");
+                let bits = blocks.block3(key);
+                for i in 0..9 {
+                    let n = key.offset((i % 3) - 1, (i / 3) - 1);
+                    assert_eq!(bits >> i & 1 == 1, minority(n), "{key:?} {i}");
+                }
             }
         }
     }

@@ -4,13 +4,13 @@
 //! finer than the shape scale the covariance of their ancestor
 //! ([`crate::shape`]).
 
-use nalgebra::Vector2;
 use rustc_hash::FxHashSet;
 
 use crate::cell::{CellStats, Gaussian, MIN_POINTS};
 use crate::cellmask::CellMask;
+use crate::gather;
 use crate::key::CellKey;
-use crate::scratch::KeyScratch;
+use crate::scratch::{KeyScratch, KeySet};
 use crate::shape::Shape;
 use crate::shaped::{Ancestor, ShapedCursor, ShapedStore};
 use crate::table::{CellTable, Cursor};
@@ -76,8 +76,9 @@ impl Distributions {
         let store = match shape {
             None => {
                 let mut map = CellTable::with_capacity(cells.len());
+                let mut sums = cells.cursor();
                 for key in cells.keys() {
-                    if let Some(g) = own_distribution(cells, cell_size, options, key) {
+                    if let Some(g) = own_distribution(&mut sums, cell_size, options, key) {
                         map.insert(key, Line(g));
                     }
                 }
@@ -311,8 +312,9 @@ fn update_own(
     options: DistOptions,
     touched: &[CellKey],
 ) {
+    let mut sums = cells.cursor();
     for key in with_minority_neighbours(search, options, touched, |_| true) {
-        match own_distribution(cells, cell_size, options, key) {
+        match own_distribution(&mut sums, cell_size, options, key) {
             Some(g) => map.insert(key, Line(g)),
             None => {
                 map.remove(key);
@@ -325,7 +327,7 @@ fn update_own(
 /// of: the level's minority cells and the keys met so far (emptied).
 struct Search<'a> {
     minority: &'a mut CellMask,
-    seen: &'a mut FxHashSet<CellKey>,
+    seen: &'a mut KeySet,
 }
 
 /// Whether a cell with sums `own` is a minority cell (§IV-A(3): fewer than
@@ -352,12 +354,15 @@ fn with_minority_neighbours(
             rest.push(key);
         }
         if options.fuse_minority {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let n = key.offset(dx, dy);
-                    if reader.contains(n) && wanted(n) && seen.insert(n) {
-                        rest.push(n);
-                    }
+            // The minority cells of the 3 × 3 block but the cell itself (met
+            // above), row by row.
+            let mut bits = reader.block3(key) & !(1 << 4);
+            while bits != 0 {
+                let i = bits.trailing_zeros() as i32;
+                bits &= bits - 1;
+                let n = key.offset(i % 3 - 1, i / 3 - 1);
+                if wanted(n) && seen.insert(n) {
+                    rest.push(n);
                 }
             }
         }
@@ -450,8 +455,9 @@ fn update_shaped(
     let unshaped = with_minority_neighbours(search, options, &searched, |k| {
         kinds.of(store, ancestor_of(k)) == Some(Ancestor::Unshaped)
     });
+    let mut sums = cells.cursor();
     for key in unshaped {
-        store.set_own(key, own_distribution(cells, cell_size, options, key));
+        store.set_own(key, own_distribution(&mut sums, cell_size, options, key));
     }
 }
 
@@ -491,7 +497,10 @@ fn set_cell(
     match store.ancestor(at) {
         Ancestor::Shaped(slot) => set_shared(store, cell_size, key, own, slot),
         Ancestor::Blocked => store.remove(key),
-        Ancestor::Unshaped => store.set_own(key, own_distribution(cells, cell_size, options, key)),
+        Ancestor::Unshaped => store.set_own(
+            key,
+            own_distribution(&mut cells.cursor(), cell_size, options, key),
+        ),
     }
 }
 
@@ -516,31 +525,34 @@ fn shape_of_ancestor(s: Shape<'_>, at: CellKey, options: DistOptions) -> Option<
 
 /// The paper's distribution of one cell under `options`, from the sums alone:
 /// eq. (7) expanded by eq. (8), fused with the neighbours for a minority cell
-/// (§IV-A(3)).
+/// (§IV-A(3): the sums of its 3 × 3 block about its centre, see
+/// [`crate::gather`]).
 fn own_distribution(
-    cells: &CellTable<CellStats>,
+    cursor: &mut Cursor<'_, CellStats>,
     cell_size: f64,
     options: DistOptions,
     key: CellKey,
 ) -> Option<Gaussian> {
-    let mut cursor = cells.cursor();
-    let own = cursor.get(key)?;
+    let none = CellStats::default();
     let centre = key.center(cell_size);
-    if own.count >= MIN_POINTS || !options.fuse_minority {
+    if !options.fuse_minority {
+        let own = cursor.get(key)?;
         return Gaussian::from_stats(own, centre, options.sigma_floor, options.expansion);
     }
-    // §IV-A(3): fuse the minority cell with its neighbours. The neighbours'
-    // sums are about their own centres; re-express them about this one.
-    let mut fused = CellStats::default();
-    for dy in -1..=1 {
-        for dx in -1..=1 {
-            if let Some(s) = cursor.get(key.offset(dx, dy)) {
-                let delta = Vector2::new(-f64::from(dx), -f64::from(dy)) * cell_size;
-                fused.merge(&s.shifted(delta));
-            }
-        }
+    let block = cursor.block3(key, &none);
+    // A cell with points has a count; `none` has none.
+    let own = block[4];
+    if own.count == 0 {
+        return None;
     }
-    Gaussian::from_stats(&fused, centre, options.sigma_floor, options.expansion)
+    let fused;
+    let stats = if own.count >= MIN_POINTS {
+        own
+    } else {
+        fused = gather::block3(&block, cell_size);
+        &fused
+    };
+    Gaussian::from_stats(stats, centre, options.sigma_floor, options.expansion)
 }
 
 #[cfg(test)]

@@ -27,6 +27,7 @@ pub mod distributions;
 pub mod error;
 pub mod filter;
 pub mod freespace;
+pub mod gather;
 pub mod grid;
 pub mod information;
 pub mod key;

@@ -7,6 +7,7 @@ use nalgebra::Vector2;
 
 use crate::cell::CellStats;
 use crate::cellmask::CellMask;
+use crate::gather;
 use crate::key::{CellKey, KeyBounds};
 use crate::scratch::KeyScratch;
 use crate::table::CellTable;
@@ -183,19 +184,11 @@ impl Pyramid {
             let (lower, upper) = (&below[l - 1], &mut above[0]);
             // The 4 children of a parent share a tile: one tile look-up at most.
             let mut children = lower.cells.cursor();
+            let none = CellStats::default();
             for &parent in &changed {
-                let mut sum = CellStats::default();
-                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                    let child = CellKey {
-                        ix: parent.ix * 2 + dx,
-                        iy: parent.iy * 2 + dy,
-                    };
-                    if let Some(s) = children.get(child) {
-                        // Children's sums are about their own centres.
-                        let delta = parent.center(upper.cell_size) - child.center(lower.cell_size);
-                        sum.merge(&s.shifted(delta));
-                    }
-                }
+                // Children's sums are about their own centres, ±½ a child
+                // cell from the parent's (crate::gather).
+                let sum = gather::quad(&children.quad(parent, &none), lower.cell_size);
                 if sum.count == 0 {
                     upper.cells.remove(parent);
                 } else {

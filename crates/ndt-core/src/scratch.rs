@@ -2,18 +2,83 @@
 //! key already?") and keeps between calls, so that each call reuses its
 //! capacity instead of allocating (and clearing) a fresh hash set. It holds
 //! nothing between calls: a clone starts empty (with the same capacity).
+//!
+//! The keys an update meets come in runs along a scan's surfaces (and the 8
+//! neighbours of a cell, §IV-A(3)), so the set keeps one bit per cell in
+//! blocks of 8 × 8 cells, found through a hash map of blocks but for the
+//! block of the last key asked about: most questions are a compare and a
+//! bit test, not a hashed look-up.
 
-use rustc_hash::FxHashSet;
+use rustc_hash::FxHashMap;
 
 use crate::key::CellKey;
 
+/// log2 of a block's side \[cells\].
+const BLOCK_BITS: i32 = 3;
+const MASK: i32 = (1 << BLOCK_BITS) - 1;
+
+/// A set of keys, a bit per cell (see the module docs).
+#[derive(Debug, Default)]
+pub(crate) struct KeySet {
+    /// Block index → its position in `words`.
+    index: FxHashMap<(i32, i32), u32>,
+    words: Vec<u64>,
+    /// The last block asked about of each parity of its index (any 2 × 2
+    /// blocks, around a cell's neighbours, have one of each), and its
+    /// position.
+    last: [Option<((i32, i32), u32)>; 4],
+}
+
+impl KeySet {
+    /// Adds `key`; `true` when it was not in the set.
+    #[inline]
+    pub(crate) fn insert(&mut self, key: CellKey) -> bool {
+        let block = (key.ix >> BLOCK_BITS, key.iy >> BLOCK_BITS);
+        let bit = 1u64 << (((key.iy & MASK) << BLOCK_BITS) | (key.ix & MASK));
+        let parity = ((block.0 & 1) | ((block.1 & 1) << 1)) as usize;
+        let at = match self.last.get(parity).copied().flatten() {
+            Some((b, at)) if b == block => at,
+            _ => self.block(block, parity),
+        };
+        match self.words.get_mut(at as usize) {
+            Some(word) => {
+                let fresh = *word & bit == 0;
+                *word |= bit;
+                fresh
+            }
+            None => false,
+        }
+    }
+
+    /// The position of `block`'s word, a new empty one when it has none.
+    #[inline(never)]
+    fn block(&mut self, block: (i32, i32), parity: usize) -> u32 {
+        let next = self.words.len() as u32;
+        let at = *self.index.entry(block).or_insert(next);
+        if at == next {
+            self.words.push(0);
+        }
+        if let Some(r) = self.last.get_mut(parity) {
+            *r = Some((block, at));
+        }
+        at
+    }
+
+    /// Empties the set, keeping its capacity.
+    pub(crate) fn clear(&mut self) {
+        self.index.clear();
+        self.words.clear();
+        self.last = [None; 4];
+    }
+}
+
 /// A reusable set of keys (see the module docs).
 #[derive(Debug, Default)]
-pub(crate) struct KeyScratch(FxHashSet<CellKey>);
+pub(crate) struct KeyScratch(KeySet);
 
 impl KeyScratch {
     /// The set, emptied (its capacity kept).
-    pub(crate) fn take(&mut self) -> &mut FxHashSet<CellKey> {
+    pub(crate) fn take(&mut self) -> &mut KeySet {
         self.0.clear();
         &mut self.0
     }
@@ -24,28 +89,71 @@ impl KeyScratch {
 /// growing the set from nothing (a rehash at every doubling).
 impl Clone for KeyScratch {
     fn clone(&self) -> Self {
-        Self(FxHashSet::with_capacity_and_hasher(
-            self.0.capacity(),
-            Default::default(),
-        ))
+        Self(KeySet {
+            index: FxHashMap::with_capacity_and_hasher(self.0.index.capacity(), Default::default()),
+            words: Vec::with_capacity(self.0.words.capacity()),
+            last: [None; 4],
+        })
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::collections::HashSet;
 
     #[test]
     fn a_clone_is_empty_with_the_capacity_of_the_original() {
         let mut scratch = KeyScratch::default();
-        scratch
-            .take()
-            .extend((0..1000).map(|i| CellKey { ix: i, iy: -i }));
+        let set = scratch.take();
+        for i in 0..1000 {
+            set.insert(CellKey {
+                ix: 9 * i,
+                iy: -9 * i,
+            });
+        }
         let mut clone = scratch.clone();
-        assert!(clone.0.is_empty());
-        assert!(clone.0.capacity() >= 1000, "{}", clone.0.capacity());
+        assert!(clone.0.words.is_empty());
+        assert!(
+            clone.0.index.capacity() >= 1000,
+            "{}",
+            clone.0.index.capacity()
+        );
         // Taking the original empties it and keeps its capacity.
-        assert!(scratch.take().is_empty());
-        assert!(clone.take().capacity() >= 1000);
+        let taken = scratch.take();
+        assert!(taken.words.is_empty() && taken.words.capacity() >= 1000);
+        assert!(taken.insert(CellKey { ix: 0, iy: 0 }));
+        assert!(clone.take().index.capacity() >= 1000);
+    }
+
+    /// `insert` answers as a hash set does, for keys in runs, scattered, and
+    /// on both sides of 0 (blocks by arithmetic shift), across `clear`s.
+    #[test]
+    fn insert_answers_as_a_hash_set() {
+        let mut set = KeySet::default();
+        let mut naive = HashSet::new();
+        let mut x: u64 = 3;
+        for round in 0..4 {
+            for step in 0..5000 {
+                x = x
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let key = if step % 3 == 0 {
+                    CellKey {
+                        ix: ((x >> 33) % 200) as i32 - 100,
+                        iy: ((x >> 13) % 200) as i32 - 100,
+                    }
+                } else {
+                    // A run: a neighbour of a recent key.
+                    CellKey {
+                        ix: (step % 17) - 8 + round,
+                        iy: ((x >> 40) % 5) as i32 - 2,
+                    }
+                };
+                assert_eq!(set.insert(key), naive.insert(key), "{key:?}");
+            }
+            set.clear();
+            naive.clear();
+        }
     }
 }

@@ -301,23 +301,28 @@ impl<T> CellTable<T> {
             )
     }
 
-    /// A reader that remembers the last tile it used (see [`Cursor`]).
+    /// A reader that remembers the last tiles it used (see [`Cursor`]).
     #[inline]
     pub fn cursor(&self) -> Cursor<'_, T> {
         Cursor {
             table: self,
-            last: None,
+            last: [None; 4],
         }
     }
 }
 
-/// Reads a [`CellTable`] remembering the last tile looked up, so runs of
-/// look-ups in one tile (a scan's consecutive points, a cell's neighbours)
-/// hash once.
+/// A tile index and its tile, if it has one.
+type Remembered = Option<((i32, i32), Option<u32>)>;
+
+/// Reads a [`CellTable`] remembering the last tile looked up of each parity
+/// of its index (`tx mod 2`, `ty mod 2`), so runs of look-ups in one tile
+/// (a scan's consecutive points) hash once, and so do the look-ups of a
+/// cell's neighbours (§IV-A) across tile borders: any 2 × 2 block of tiles
+/// has one tile of each parity.
 #[derive(Debug)]
 pub struct Cursor<'a, T> {
     table: &'a CellTable<T>,
-    last: Option<((i32, i32), Option<u32>)>,
+    last: [Remembered; 4],
 }
 
 impl<'a, T> Cursor<'a, T> {
@@ -325,19 +330,99 @@ impl<'a, T> Cursor<'a, T> {
     #[inline(always)]
     pub fn get(&mut self, key: CellKey) -> Option<&'a T> {
         let (tile, slot) = split(key);
-        let t = match self.last {
+        let parity = ((tile.0 & 1) | ((tile.1 & 1) << 1)) as usize;
+        let t = match self.last.get(parity).copied().flatten() {
             Some((k, t)) if k == tile => t,
-            _ => self.find_tile(tile),
+            _ => self.find_tile(tile, parity),
         };
         self.table.value_at(t?, slot)
     }
 
-    /// The hashed look-up of a tile other than the last one (kept out of
-    /// line, so the common path inlines into the matcher's loop).
+    /// The slots of tile `tile`, if it has any (through the remembered
+    /// tiles, as [`Cursor::get`]).
+    #[inline(always)]
+    fn tile_slots(&mut self, tile: (i32, i32)) -> Option<&'a Tile> {
+        let parity = ((tile.0 & 1) | ((tile.1 & 1) << 1)) as usize;
+        let t = match self.last.get(parity).copied().flatten() {
+            Some((k, t)) if k == tile => t,
+            _ => self.find_tile(tile, parity),
+        };
+        self.table.slots.get(t? as usize)
+    }
+
+    /// The value in slot `slot` of `tile`, or `none` (an empty slot's index
+    /// is out of the values' range: one compare, no branch on the pattern
+    /// of occupied cells).
+    #[inline(always)]
+    fn in_tile<'b>(&self, tile: &Tile, slot: usize, none: &'b T) -> &'b T
+    where
+        'a: 'b,
+    {
+        let i = tile.get(slot).copied().unwrap_or(EMPTY);
+        self.table.values.get(i as usize).unwrap_or(none)
+    }
+
+    /// The values of the 3 × 3 block of cells around `key`, row by row
+    /// (`iy − 1` first, `ix − 1` first in a row), `none` for a cell without
+    /// one: the neighbourhood of §IV-A(3). The block lies in at most 2 × 2
+    /// tiles (one of each parity: remembered together), whose slots are
+    /// read directly, with no branch on where in its tile the cell is.
+    #[inline]
+    pub fn block3<'b>(&mut self, key: CellKey, none: &'b T) -> [&'b T; 9]
+    where
+        'a: 'b,
+    {
+        const NO_TILE: Tile = [EMPTY; (TILE * TILE) as usize];
+        let (x0, y0) = (key.ix - 1, key.iy - 1);
+        let (tx0, ty0) = (x0 >> TILE_BITS, y0 >> TILE_BITS);
+        let (tx1, ty1) = ((x0 + 2) >> TILE_BITS, (y0 + 2) >> TILE_BITS);
+        let tiles = [(tx0, ty0), (tx1, ty0), (tx0, ty1), (tx1, ty1)]
+            .map(|t| self.tile_slots(t).unwrap_or(&NO_TILE));
+        let mut out = [none; 9];
+        for (i, o) in (0..9).zip(out.iter_mut()) {
+            let (x, y) = (x0 + i % 3, y0 + i / 3);
+            let which =
+                usize::from(x >> TILE_BITS != tx0) | usize::from(y >> TILE_BITS != ty0) << 1;
+            let slot = ((y & MASK) * TILE + (x & MASK)) as usize;
+            *o = self.in_tile(tiles[which & 3], slot, none);
+        }
+        out
+    }
+
+    /// The values of the 4 cells of this level under cell `parent` of the
+    /// level above (keys `2 · parent + (0|1, 0|1)`), in the order (0, 0),
+    /// (1, 0), (0, 1), (1, 1), `none` for a cell without one. The 4 always
+    /// share a tile.
+    #[inline]
+    pub fn quad<'b>(&mut self, parent: CellKey, none: &'b T) -> [&'b T; 4]
+    where
+        'a: 'b,
+    {
+        let first = CellKey {
+            ix: parent.ix * 2,
+            iy: parent.iy * 2,
+        };
+        let (tile, slot) = split(first);
+        let Some(slots) = self.tile_slots(tile) else {
+            return [none; 4];
+        };
+        let row = TILE as usize;
+        [
+            self.in_tile(slots, slot, none),
+            self.in_tile(slots, slot + 1, none),
+            self.in_tile(slots, slot + row, none),
+            self.in_tile(slots, slot + row + 1, none),
+        ]
+    }
+
+    /// The hashed look-up of a tile not remembered (kept out of line, so
+    /// the common path inlines into the matcher's loop).
     #[inline(never)]
-    fn find_tile(&mut self, tile: (i32, i32)) -> Option<u32> {
+    fn find_tile(&mut self, tile: (i32, i32), parity: usize) -> Option<u32> {
         let t = self.table.tiles.get(&tile).copied();
-        self.last = Some((tile, t));
+        if let Some(r) = self.last.get_mut(parity) {
+            *r = Some((tile, t));
+        }
         t
     }
 }
@@ -381,6 +466,28 @@ mod tests {
                 let key = CellKey { ix, iy };
                 assert_eq!(table.get(key), naive.get(&key));
                 assert_eq!(cursor.get(key), naive.get(&key));
+            }
+        }
+        // Blocks and quads read what single look-ups read, inside tiles,
+        // across their borders and where no tile is.
+        let mut blocks = table.cursor();
+        let none = -1;
+        for ix in -22..22 {
+            for iy in -20..20 {
+                let key = CellKey { ix, iy };
+                let block = blocks.block3(key, &none);
+                for (i, got) in block.iter().enumerate() {
+                    let n = key.offset((i % 3) as i32 - 1, (i / 3) as i32 - 1);
+                    assert_eq!(**got, *naive.get(&n).unwrap_or(&none), "{key:?} {i}");
+                }
+                let quad = blocks.quad(key, &none);
+                for (i, got) in quad.iter().enumerate() {
+                    let child = CellKey {
+                        ix: 2 * ix + (i % 2) as i32,
+                        iy: 2 * iy + (i / 2) as i32,
+                    };
+                    assert_eq!(**got, *naive.get(&child).unwrap_or(&none), "{key:?} {i}");
+                }
             }
         }
         // Equal to a table of the same entries inserted in another order.
