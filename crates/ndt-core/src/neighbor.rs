@@ -31,11 +31,27 @@ pub fn nearest_in_rings_with<L: DistLookup>(
     key: CellKey,
     radius: u32,
 ) -> Option<L::Dist> {
+    nearest_in_rings_counted(cursor, point, key, radius).0
+}
+
+/// [`nearest_in_rings_with`], with the number of distributions in the ring
+/// the result was taken from (0 when none was found). With at most one the
+/// result does not depend on where in cell `key` the point is: a caller may
+/// keep it for any point of that cell ([`crate::pairs`]).
+#[inline]
+pub fn nearest_in_rings_counted<L: DistLookup>(
+    cursor: &mut L,
+    point: Vector2<f64>,
+    key: CellKey,
+    radius: u32,
+) -> (Option<L::Dist>, usize) {
     let radius = i32::try_from(radius).unwrap_or(i32::MAX);
     for r in 1..=radius {
         let mut best: Option<(f64, L::Dist)> = None;
+        let mut found = 0;
         let mut consider = |dx: i32, dy: i32| {
             if let Some(g) = cursor.get(key.offset(dx, dy)) {
+                found += 1;
                 let d2 = (g.borrow().mean - point).norm_squared();
                 if best.is_none_or(|(b, _)| d2 < b) {
                     best = Some((d2, g));
@@ -51,8 +67,8 @@ pub fn nearest_in_rings_with<L: DistLookup>(
             consider(r, dy);
         }
         if let Some((_, g)) = best {
-            return Some(g);
+            return (Some(g), found);
         }
     }
-    None
+    (None, 0)
 }

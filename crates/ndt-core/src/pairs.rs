@@ -25,7 +25,7 @@ use nalgebra::Vector2;
 use crate::batch::{pass_terms, Chunk, LaneSums, PassTerms, Scan, LANES, SUMS};
 use crate::distributions::{CursorVisitor, DistLookup, Distributions};
 use crate::key::{CellKey, MAX_INDEX};
-use crate::neighbor::nearest_in_rings_with;
+use crate::neighbor::nearest_in_rings_counted;
 use crate::score::Order;
 use crate::se2::Pose2;
 
@@ -36,15 +36,18 @@ struct KeyLanes {
     iy: [i32; LANES],
 }
 
-/// What is known of the pairs of one chunk's points, a bit per lane.
+/// What is known of the pairs of one chunk's points, a bit per lane, for
+/// the lane's kept key.
 #[derive(Debug, Clone, Copy, Default)]
 struct Known {
-    /// The lane's own cell (its kept key) has a distribution, which the
-    /// lane holds.
-    own: u8,
-    /// The lane's own cell (its kept key) has none: the lane is paired by
-    /// the neighbour search, anew at every evaluation.
+    /// The lane's pair (or its having none) holds wherever in that cell
+    /// the point is: its own cell's distribution, or the neighbour search's
+    /// result when the ring it came from holds at most one distribution.
+    fixed: u8,
+    /// The cell has no distribution (the neighbour search pairs the lane).
     searched: u8,
+    /// The lane holds a pair.
+    paired: u8,
 }
 
 /// The points of a scan (optionally weighted, see [`crate::reduce`]) with
@@ -94,7 +97,7 @@ impl<'a> ScanPairs<'a> {
     /// Score terms of the points at `pose` against `dists` (cells of
     /// `1 / inv_cell` m), each paired with its own cell's distribution or,
     /// when `search_radius` is given and that cell has none, the nearest
-    /// found by [`nearest_in_rings_with`]. Pairs kept from an evaluation
+    /// found by [`crate::neighbor::nearest_in_rings_with`]. Pairs kept from an evaluation
     /// against other distributions are forgotten first.
     pub fn evaluate(
         &mut self,
@@ -130,6 +133,9 @@ impl<'a> ScanPairs<'a> {
     }
 }
 
+/// `1.5 · 2⁵²`: adding it rounds to an integer held in the low mantissa bits.
+const ROUND: f64 = 6_755_399_441_055_744.0;
+
 /// The cell of every point at a pose (`sin θ, cos θ, tx, ty`, then `1 /
 /// cell size`): into `fresh`, with per chunk the lanes whose cell exists
 /// (`valid`: as [`CellKey::of`] gives `Some`, the same index) and the valid
@@ -163,9 +169,13 @@ fn cell_keys(
             let vx = (cs * x - sn * y + tx) * inv;
             let vy = (sn * x + cs * y + ty) * inv;
             ok[l] = vx >= 1.0 - lim && vx < lim && vy >= 1.0 - lim && vy < lim;
-            let (kx, ky) = (vx as i32, vy as i32);
-            let ix = kx - i32::from(f64::from(kx) > vx);
-            let iy = ky - i32::from(f64::from(ky) > vy);
+            // ⌊v⌋ without a conversion instruction (they do not vectorise):
+            // adding 1.5 · 2⁵² rounds v to the nearest integer, held in the
+            // low bits (exact for |v| < 2⁵¹; lanes out of range are not
+            // valid anyway), then one down where that is above v.
+            let (rx, ry) = (vx + ROUND, vy + ROUND);
+            let ix = (rx.to_bits() as i32) - i32::from(rx - ROUND > vx);
+            let iy = (ry.to_bits() as i32) - i32::from(ry - ROUND > vy);
             fresh.ix[l] = ix;
             fresh.iy[l] = iy;
             eq[l] = ix == kept.ix[l] && iy == kept.iy[l];
@@ -217,9 +227,9 @@ impl CursorVisitor for Refresh<'_, '_> {
             } else {
                 (1u8 << lanes) - 1
             };
-            // The lanes whose own pair is kept: nothing to do.
-            let hit = same & known.own;
-            matched += hit.count_ones() as usize;
+            // The lanes whose pair is kept: nothing to do.
+            let hit = same & known.fixed;
+            matched += (hit & known.paired).count_ones() as usize;
             if hit == all {
                 continue;
             }
@@ -228,8 +238,9 @@ impl CursorVisitor for Refresh<'_, '_> {
                 if hit & bit != 0 {
                     continue;
                 }
+                known.fixed &= !bit;
+                known.paired &= !bit;
                 if valid & bit == 0 {
-                    known.own &= !bit;
                     known.searched &= !bit;
                     ch.clear_pair(l);
                     continue;
@@ -245,24 +256,29 @@ impl CursorVisitor for Refresh<'_, '_> {
                     kept.iy[l] = key.iy;
                     if let Some(g) = cursor.get(key) {
                         ch.set_pair(l, w, g.borrow(), true);
-                        known.own |= bit;
                         known.searched &= !bit;
+                        known.fixed |= bit;
+                        known.paired |= bit;
                         matched += 1;
                         continue;
                     }
+                    known.searched |= bit;
                 }
-                known.own &= !bit;
-                known.searched |= bit;
                 let Some(p) = points.get(i) else {
                     break;
                 };
                 let xw = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
-                match self
-                    .search_radius
-                    .and_then(|r| nearest_in_rings_with(&mut cursor, xw, key, r))
-                {
+                let (g, candidates) = match self.search_radius {
+                    Some(r) => nearest_in_rings_counted(&mut cursor, xw, key, r),
+                    None => (None, 0),
+                };
+                if candidates <= 1 {
+                    known.fixed |= bit;
+                }
+                match g {
                     Some(g) => {
                         ch.set_pair(l, w, g.borrow(), false);
+                        known.paired |= bit;
                         matched += 1;
                     }
                     None => ch.clear_pair(l),
@@ -280,6 +296,7 @@ mod tests {
     use crate::batch::PairBlock;
     use crate::distributions::DistOptions;
     use crate::grid::NdtGrid;
+    use crate::neighbor::nearest_in_rings_with;
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
 
@@ -333,6 +350,83 @@ mod tests {
             && x.iter()
                 .zip(&y)
                 .all(|(p, q)| (p - q).abs() <= 1e-12 * scale)
+    }
+
+    /// The vectorised cells are [`CellKey::of`]'s, on both sides of 0, at
+    /// and next to integers and halves, and the lanes it refuses (beyond
+    /// the index range, not finite) are the ones marked not valid.
+    #[test]
+    fn cell_keys_are_those_of_cell_key_of() {
+        let mut rng = StdRng::seed_from_u64(3);
+        let lim = f64::from(MAX_INDEX);
+        let mut values: Vec<f64> = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            -2.5,
+            1.0,
+            -1.0,
+            0.999_999_999_999_999_9,
+            -1e-300,
+            1e-300,
+            lim - 1.0,
+            lim - 0.5,
+            lim,
+            -lim,
+            1.0 - lim,
+            1.0 - lim - 1e-6,
+            2.0 * lim,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        for _ in 0..2000 {
+            let v: f64 = rng.random_range(-1e4..1e4);
+            values.extend([v, v.floor(), v.floor() + 0.5, v.floor() - 1e-12]);
+        }
+        for inv in [1.0, 50.0, 0.25] {
+            for pair in values.chunks(2 * LANES) {
+                let mut ch = Chunk::default();
+                for (l, v) in pair.chunks(2).enumerate() {
+                    ch.x[l] = v[0] / inv;
+                    ch.y[l] = *v.get(1).unwrap_or(&0.3) / inv;
+                }
+                let (mut fresh, mut valid, mut same) = ([KeyLanes::default()], [0], [0]);
+                let kept = [KeyLanes::default()];
+                cell_keys(
+                    &[ch],
+                    [0.0, 1.0, 0.0, 0.0, inv],
+                    &kept,
+                    &mut fresh,
+                    &mut valid,
+                    &mut same,
+                );
+                for l in 0..LANES {
+                    let want = CellKey::of(Vector2::new(ch.x[l], ch.y[l]), inv);
+                    assert_eq!(
+                        valid[0] >> l & 1 == 1,
+                        want.is_some(),
+                        "{} {}",
+                        ch.x[l],
+                        ch.y[l]
+                    );
+                    if let Some(k) = want {
+                        assert_eq!(
+                            (fresh[0].ix[l], fresh[0].iy[l]),
+                            (k.ix, k.iy),
+                            "{} {}",
+                            ch.x[l],
+                            ch.y[l]
+                        );
+                        assert_eq!(same[0] >> l & 1 == 1, k.ix == 0 && k.iy == 0);
+                    }
+                }
+            }
+        }
     }
 
     /// Along a random walk of poses (points crossing cells, leaving the map,
