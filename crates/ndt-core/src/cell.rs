@@ -56,6 +56,13 @@ pub struct CellStats {
 }
 
 impl CellStats {
+    /// `M` as a float. Through `i64`: one instruction, where `u64` takes a
+    /// dozen on x86-64 (no count comes near 2⁶³; the value is the same).
+    #[inline(always)]
+    pub fn points(&self) -> f64 {
+        self.count as i64 as f64
+    }
+
     /// eq. (6) for one point `x − o` \[m\].
     #[inline]
     pub fn add_point(&mut self, d: Vector2<f64>) {
@@ -76,7 +83,7 @@ impl CellStats {
     /// The same sums about the origin `o + delta`: with `y = x − o − delta`,
     /// `m' = m − M δ` and `S' = S − δ mᵀ − m δᵀ + M δ δᵀ` (exact).
     pub fn shifted(&self, delta: Vector2<f64>) -> CellStats {
-        let n = self.count as f64;
+        let n = self.points();
         CellStats {
             count: self.count,
             sum: self.sum - delta * n,
@@ -89,14 +96,14 @@ impl CellStats {
     /// empty cell.
     #[inline]
     pub fn mean(&self) -> Option<Vector2<f64>> {
-        (self.count > 0).then(|| self.sum / self.count as f64)
+        (self.count > 0).then(|| self.sum / self.points())
     }
 
     /// eq. (7): mean about the origin `q − o = m / M` and covariance
     /// `Σ = (S − q mᵀ) / M` (shift invariant). `None` for an empty cell.
     pub fn mean_and_covariance(&self) -> Option<(Vector2<f64>, Matrix2<f64>)> {
         let q = self.mean()?;
-        let n = self.count as f64;
+        let n = self.points();
         let mut cov = (self.scatter - q * self.sum.transpose()) / n;
         // Symmetrise against round-off.
         let off = 0.5 * (cov[(0, 1)] + cov[(1, 0)]);

@@ -10,6 +10,7 @@ use crate::cell::{CellStats, Gaussian, MIN_POINTS};
 use crate::cellmask::CellMask;
 use crate::gather;
 use crate::key::CellKey;
+use crate::moments::{self, GaussBatch, StatsBatch};
 use crate::scratch::{KeyScratch, KeySet};
 use crate::shape::Shape;
 use crate::shaped::{Ancestor, ShapedCursor, ShapedStore};
@@ -76,12 +77,12 @@ impl Distributions {
         let store = match shape {
             None => {
                 let mut map = CellTable::with_capacity(cells.len());
-                let mut sums = cells.cursor();
-                for key in cells.keys() {
-                    if let Some(g) = own_distribution(&mut sums, cell_size, options, key) {
+                let keys: Vec<CellKey> = cells.keys().collect();
+                own_distributions(cells, cell_size, options, &keys, |key, g| {
+                    if let Some(g) = g {
                         map.insert(key, Line(g));
                     }
-                }
+                });
                 Store::Own(map)
             }
             Some(s) => {
@@ -312,15 +313,13 @@ fn update_own(
     options: DistOptions,
     touched: &[CellKey],
 ) {
-    let mut sums = cells.cursor();
-    for key in with_minority_neighbours(search, options, touched, |_| true) {
-        match own_distribution(&mut sums, cell_size, options, key) {
-            Some(g) => map.insert(key, Line(g)),
-            None => {
-                map.remove(key);
-            }
+    let keys = with_minority_neighbours(search, options, touched, |_| true);
+    own_distributions(cells, cell_size, options, &keys, |key, g| match g {
+        Some(g) => map.insert(key, Line(g)),
+        None => {
+            map.remove(key);
         }
-    }
+    });
 }
 
 /// What the minority-neighbour search of one update reads and keeps track
@@ -455,10 +454,9 @@ fn update_shaped(
     let unshaped = with_minority_neighbours(search, options, &searched, |k| {
         kinds.of(store, ancestor_of(k)) == Some(Ancestor::Unshaped)
     });
-    let mut sums = cells.cursor();
-    for key in unshaped {
-        store.set_own(key, own_distribution(&mut sums, cell_size, options, key));
-    }
+    own_distributions(cells, cell_size, options, &unshaped, |key, g| {
+        store.set_own(key, g);
+    });
 }
 
 /// The kinds of ancestors during one shaped update, remembering the last
@@ -497,10 +495,11 @@ fn set_cell(
     match store.ancestor(at) {
         Ancestor::Shaped(slot) => set_shared(store, cell_size, key, own, slot),
         Ancestor::Blocked => store.remove(key),
-        Ancestor::Unshaped => store.set_own(
-            key,
-            own_distribution(&mut cells.cursor(), cell_size, options, key),
-        ),
+        Ancestor::Unshaped => {
+            own_distributions(cells, cell_size, options, &[key], |key, g| {
+                store.set_own(key, g);
+            });
+        }
     }
 }
 
@@ -523,36 +522,59 @@ fn shape_of_ancestor(s: Shape<'_>, at: CellKey, options: DistOptions) -> Option<
         .map(|region| Gaussian::shape_of(region, options.sigma_floor, options.expansion))
 }
 
-/// The paper's distribution of one cell under `options`, from the sums alone:
-/// eq. (7) expanded by eq. (8), fused with the neighbours for a minority cell
-/// (§IV-A(3): the sums of its 3 × 3 block about its centre, see
+/// The sums the paper's distribution of cell `key` comes from (`None`
+/// when it has no points): its own, or for a minority cell with fusion
+/// (§IV-A(3)) those of its 3 × 3 block about its centre (see
 /// [`crate::gather`]).
-fn own_distribution(
+#[inline]
+fn own_stats(
     cursor: &mut Cursor<'_, CellStats>,
     cell_size: f64,
     options: DistOptions,
     key: CellKey,
-) -> Option<Gaussian> {
-    let none = CellStats::default();
-    let centre = key.center(cell_size);
+) -> Option<CellStats> {
     if !options.fuse_minority {
-        let own = cursor.get(key)?;
-        return Gaussian::from_stats(own, centre, options.sigma_floor, options.expansion);
+        return cursor.get(key).copied();
     }
+    let none = CellStats::default();
     let block = cursor.block3(key, &none);
     // A cell with points has a count; `none` has none.
     let own = block[4];
     if own.count == 0 {
-        return None;
-    }
-    let fused;
-    let stats = if own.count >= MIN_POINTS {
-        own
+        None
+    } else if own.count >= MIN_POINTS {
+        Some(*own)
     } else {
-        fused = gather::block3(&block, cell_size);
-        &fused
-    };
-    Gaussian::from_stats(stats, centre, options.sigma_floor, options.expansion)
+        Some(gather::block3(&block, cell_size))
+    }
+}
+
+/// The paper's distribution of each cell of `keys` under `options`, from
+/// the sums alone: eq. (7) expanded by eq. (8) ([`own_stats`]'s sums),
+/// [`moments::BATCH`] cells at a time; `emit` takes each key with its
+/// distribution (`None`: it has none), in order.
+fn own_distributions(
+    cells: &CellTable<CellStats>,
+    cell_size: f64,
+    options: DistOptions,
+    keys: &[CellKey],
+    mut emit: impl FnMut(CellKey, Option<Gaussian>),
+) {
+    let mut cursor = cells.cursor();
+    let mut stats = StatsBatch::default();
+    let mut out = GaussBatch::default();
+    for batch in keys.chunks(moments::BATCH) {
+        let mut present = [false; moments::BATCH];
+        for ((l, &key), p) in batch.iter().enumerate().zip(present.iter_mut()) {
+            let s = own_stats(&mut cursor, cell_size, options, key);
+            *p = s.is_some();
+            stats.set(l, &s.unwrap_or_default(), key.center(cell_size));
+        }
+        moments::gaussians(&stats, options.sigma_floor, options.expansion, &mut out);
+        for ((l, &key), p) in batch.iter().enumerate().zip(present) {
+            emit(key, out.get(l).filter(|_| p));
+        }
+    }
 }
 
 #[cfg(test)]

@@ -76,7 +76,7 @@ pub fn block3(cells: &[&CellStats; 9], h: f64) -> CellStats {
     for (r, row) in cells.chunks_exact(3).enumerate() {
         let [a, b, c] = [row[0], row[1], row[2]];
         count += a.count + b.count + c.count;
-        let (ka, kb, kc) = (a.count as f64, b.count as f64, c.count as f64);
+        let (ka, kb, kc) = (a.points(), b.points(), c.points());
         s += a.scatter + b.scatter + c.scatter;
         if let (Some(nr), Some(mr), Some(xnr), Some(xmr), Some(x2r)) = (
             n.get_mut(r),
@@ -111,7 +111,7 @@ pub fn block3(cells: &[&CellStats; 9], h: f64) -> CellStats {
 pub fn quad(children: &[&CellStats; 4], h: f64) -> CellStats {
     let c = children;
     let count = c[0].count + c[1].count + c[2].count + c[3].count;
-    let n = c.map(|c| c.count as f64);
+    let n = c.map(CellStats::points);
     let m = c.map(|c| c.sum);
     let s = c[0].scatter + c[1].scatter + c[2].scatter + c[3].scatter;
     // eₓ = ½ for children 1 and 3, −½ for 0 and 2; e_y = ½ for 2 and 3.

@@ -36,6 +36,7 @@ pub mod mapper;
 pub mod mapworker;
 pub mod matcher;
 pub mod memo;
+pub mod moments;
 pub mod neighbor;
 pub mod odometry;
 pub mod pairs;

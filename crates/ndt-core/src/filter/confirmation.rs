@@ -123,7 +123,7 @@ pub fn passed_cells(
             if stats.count == 0 {
                 return true;
             }
-            let mean = key.center(cell_size) + stats.sum / stats.count as f64;
+            let mean = key.center(cell_size) + stats.sum / stats.points();
             let rel = mean - sensor;
             let along = rel.dot(&dir);
             let side = dir.x * rel.y - dir.y * rel.x;

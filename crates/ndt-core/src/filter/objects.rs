@@ -56,7 +56,7 @@ pub fn group_objects(grid: &NdtGrid, keys: &[CellKey]) -> Vec<SmallObject> {
         let (mut sum, mut points) = (Vector2::zeros(), 0u64);
         for k in &cells {
             if let Some(s) = grid.stats(*k) {
-                sum += s.sum + k.center(cell_size) * s.count as f64;
+                sum += s.sum + k.center(cell_size) * s.points();
                 points += s.count;
             }
         }
