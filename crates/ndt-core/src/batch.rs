@@ -17,7 +17,7 @@
 //! [`PairBlock`] queues any number of pairs per point (the 3 × 3 pairing of
 //! `MatchOptions::pair_neighbors`); the matcher's usual one pair per point
 //! keeps its columns between evaluations instead ([`crate::pairs`]), with the
-//! same arithmetic ([`add_chunks`]).
+//! same arithmetic.
 
 use multiversion::multiversion;
 use nalgebra::{Matrix3, Vector3};
