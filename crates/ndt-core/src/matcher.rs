@@ -15,7 +15,7 @@ use crate::information::{own_cell_pairs, point_to_plane_information};
 use crate::key::CellKey;
 use crate::memo::LevelMemo;
 use crate::neighbor::nearest_in_rings_with;
-use crate::pairs::ScanPairs;
+use crate::pairs::{evaluate_streaming, ScanPairs};
 use crate::quadratic::QuadraticModel;
 use crate::reduce::voxel_runs;
 use crate::score::{Order, ScoreTerms};
@@ -342,6 +342,19 @@ pub struct MatchResult {
     pub unconstrained: Vec<[f64; 3]>,
 }
 
+/// Most points whose pairs a match keeps on one thread (about 100 bytes a
+/// point and level, [`crate::pairs`]): beyond, each evaluation streams the
+/// points through a small block ([`evaluate_streaming`], the same terms),
+/// whose look-ups cost less than reading kept pairs that no longer fit in
+/// the caches. `cargo bench --bench core -- match_large/one_thread`,
+/// alternating with the build before kept pairs (595ccaa), three rounds
+/// each: with every scan's pairs kept, 8192 points took 1.95 ms against
+/// 1.67–2.17 ms, 16384 points 4.30–4.46 against 3.49–3.74 ms and 32000
+/// points 9.2–11.4 against 7.8–8.3 ms; streamed beyond 4096 points, 8192
+/// points 2.09–2.16 against 2.03–2.21 ms and 32000 points 7.9–8.7 against
+/// 7.6–8.5 ms, while 2000 points (kept) take 338–359 against 457–563 µs.
+pub const KEPT_MAX_POINTS: usize = 4096;
+
 /// Levels whose pairs a match keeps at once ([`MatchPairs`]): a stage
 /// scores its own level and, at its start and for the final pose, the next
 /// coarser one.
@@ -431,6 +444,17 @@ impl<'a> MatchPairs<'a> {
             );
         }
         let radius = options.neighbor_search.then_some(options.search_radius);
+        if !self.parallel && self.points.len() > KEPT_MAX_POINTS {
+            return evaluate_streaming(
+                dists,
+                self.points,
+                self.weights,
+                pose,
+                inv_cell,
+                radius,
+                order,
+            );
+        }
         let segments = self.level(dists.level());
         if let [one] = segments.as_mut_slice() {
             return one.evaluate(dists, pose, inv_cell, radius, order);

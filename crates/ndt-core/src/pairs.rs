@@ -74,31 +74,47 @@ impl<'a> ScanPairs<'a> {
     /// without weights), with nothing paired yet.
     pub fn new(points: &'a [[f64; 2]], weights: Option<&'a [f64]>) -> Self {
         let n = points.len().div_ceil(LANES);
-        let mut chunks = vec![Chunk::default(); n];
-        for (ch, pts) in chunks.iter_mut().zip(points.chunks(LANES)) {
-            for (l, p) in pts.iter().enumerate() {
-                ch.x[l] = p[0];
-                ch.y[l] = p[1];
-            }
-        }
-        Self {
+        let mut pairs = Self {
             points,
             weights,
             source: None,
-            chunks,
+            chunks: vec![Chunk::default(); n],
             keys: vec![KeyLanes::default(); n],
             known: vec![Known::default(); n],
             fresh: vec![KeyLanes::default(); n],
             valid: vec![0; n],
             same: vec![0; n],
+        };
+        pairs.bind(points, weights);
+        pairs
+    }
+
+    /// The same pairs' storage for other `points` (at most as many as at
+    /// [`ScanPairs::new`]; any more are left out), with nothing paired.
+    fn bind(&mut self, points: &'a [[f64; 2]], weights: Option<&'a [f64]>) {
+        let n = points.len().div_ceil(LANES).min(self.keys.len());
+        self.points = points
+            .get(..(n * LANES).min(points.len()))
+            .unwrap_or(points);
+        self.weights = weights;
+        self.source = None;
+        self.chunks.truncate(n);
+        for (c, ch) in self.chunks.iter_mut().enumerate() {
+            for l in 0..LANES {
+                let p = self.points.get(c * LANES + l).copied().unwrap_or([0.0; 2]);
+                ch.x[l] = p[0];
+                ch.y[l] = p[1];
+                // Lanes past the last point (padding) add exact zeros.
+                ch.clear_pair(l);
+            }
         }
     }
 
     /// Score terms of the points at `pose` against `dists` (cells of
     /// `1 / inv_cell` m), each paired with its own cell's distribution or,
     /// when `search_radius` is given and that cell has none, the nearest
-    /// found by [`crate::neighbor::nearest_in_rings_with`]. Pairs kept from an evaluation
-    /// against other distributions are forgotten first.
+    /// found by [`crate::neighbor::nearest_in_rings_with`]. Pairs kept from
+    /// an evaluation against other distributions are forgotten first.
     pub fn evaluate(
         &mut self,
         dists: &Distributions,
@@ -107,16 +123,31 @@ impl<'a> ScanPairs<'a> {
         search_radius: Option<u32>,
         order: Order,
     ) -> PassTerms {
+        let scan = Scan::new(pose, order);
+        let mut sums: LaneSums = [[0.0; LANES]; SUMS];
+        let matched = self.accumulate(dists, &scan, inv_cell, search_radius, &mut sums);
+        pass_terms(&sums, matched)
+    }
+
+    /// The terms of [`ScanPairs::evaluate`] added to `sums` (lane by lane,
+    /// chunk after chunk); returns the number of points paired.
+    fn accumulate(
+        &mut self,
+        dists: &Distributions,
+        scan: &Scan,
+        inv_cell: f64,
+        search_radius: Option<u32>,
+        sums: &mut LaneSums,
+    ) -> usize {
         let source = std::ptr::from_ref(dists) as usize;
         if self.source != Some(source) {
             self.known.fill(Known::default());
             self.source = Some(source);
         }
-        let scan = Scan::new(pose, order);
         let (s, c) = scan.sin_cos;
         cell_keys(
             &self.chunks,
-            [s, c, pose.x, pose.y, inv_cell],
+            [s, c, scan.pose.x, scan.pose.y, inv_cell],
             &self.keys,
             &mut self.fresh,
             &mut self.valid,
@@ -124,13 +155,45 @@ impl<'a> ScanPairs<'a> {
         );
         let matched = dists.visit(Refresh {
             pairs: self,
-            scan: &scan,
+            scan,
             search_radius,
         });
-        let mut sums: LaneSums = [[0.0; LANES]; SUMS];
-        scan.add(&self.chunks, &mut sums);
-        pass_terms(&sums, matched)
+        scan.add(&self.chunks, sums);
+        matched
     }
+}
+
+/// Points of a block of [`evaluate_streaming`] (a multiple of [`LANES`];
+/// smaller in the tests, so that their scans take several blocks).
+#[cfg(not(test))]
+const STREAM_BLOCK: usize = 256;
+#[cfg(test)]
+const STREAM_BLOCK: usize = 64;
+
+/// [`ScanPairs::evaluate`] with nothing kept, for a scan whose kept pairs
+/// would not fit in the processor's caches (their columns take about 100
+/// bytes a point): the points go through one small [`ScanPairs`] a block at
+/// a time. The lanes and their order are those of one [`ScanPairs`] over all
+/// the points (blocks are whole chunks), so the terms are the same bits.
+pub fn evaluate_streaming(
+    dists: &Distributions,
+    points: &[[f64; 2]],
+    weights: Option<&[f64]>,
+    pose: Pose2,
+    inv_cell: f64,
+    search_radius: Option<u32>,
+    order: Order,
+) -> PassTerms {
+    let scan = Scan::new(pose, order);
+    let mut sums: LaneSums = [[0.0; LANES]; SUMS];
+    let mut matched = 0;
+    let mut pairs = ScanPairs::new(points.get(..STREAM_BLOCK).unwrap_or(points), None);
+    for (i, block) in points.chunks(STREAM_BLOCK).enumerate() {
+        let w = weights.and_then(|w| w.get(i * STREAM_BLOCK..i * STREAM_BLOCK + block.len()));
+        pairs.bind(block, w);
+        matched += pairs.accumulate(dists, &scan, inv_cell, search_radius, &mut sums);
+    }
+    pass_terms(&sums, matched)
 }
 
 /// `1.5 · 2⁵²`: adding it rounds to an integer held in the low mantissa bits.
@@ -485,6 +548,9 @@ mod tests {
                     let got = kept.evaluate(d, pose, inv, radius, order);
                     let fresh = ScanPairs::new(&points, w).evaluate(d, pose, inv, radius, order);
                     assert_eq!(got, fresh, "step {step}");
+                    // Block by block (203 points: a partial last block).
+                    let streamed = evaluate_streaming(d, &points, w, pose, inv, radius, order);
+                    assert_eq!(got, streamed, "step {step}");
                     let want = by_block(d, &points, w, pose, radius, order);
                     assert!(close(&got, &want), "step {step}: {got:?} vs {want:?}");
                 }
