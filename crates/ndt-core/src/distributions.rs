@@ -98,7 +98,9 @@ impl Distributions {
                 Store::Shaped(store)
             }
         };
-        let minority = if options.fuse_minority {
+        // The shaped update finds minority neighbours by the mask; the own
+        // update reads them off the sums it fetches anyway.
+        let minority = if options.fuse_minority && matches!(store, Store::Shaped(_)) {
             CellMask::of(
                 cells
                     .iter()
@@ -140,25 +142,18 @@ impl Distributions {
         touched: &[CellKey],
         shape: Option<Shape<'_>>,
     ) {
-        // With fusion the minority mask takes the touched cells' new counts
-        // before any neighbour is searched (the shaped update does it in its
-        // own pass over the touched cells, which reads their sums anyway).
-        if self.options.fuse_minority && !matches!(self.store, Store::Shaped(_)) {
-            let mut sums = cells.cursor();
-            self.minority
-                .set_each(touched, |key| is_minority(sums.get(key)));
-        }
         let options = self.options;
-        let search = Search {
-            minority: &mut self.minority,
-            seen: self.seen.take(),
-        };
+        let seen = self.seen.take();
         match (&mut self.store, shape) {
             (Store::Shaped(store), Some(s)) => {
+                let search = Search {
+                    minority: &mut self.minority,
+                    seen,
+                };
                 update_shaped(store, search, cells, cell_size, options, touched, s);
             }
             (Store::Own(map), _) => {
-                update_own(map, search, cells, cell_size, options, touched);
+                update_own(map, seen, cells, cell_size, options, touched);
             }
             // Built with a shape level, updated without one: cannot happen
             // (the grid passes the same depth); rebuild rather than go stale.
@@ -302,24 +297,56 @@ impl DistLookup for DistCursor<'_> {
 }
 
 /// [`Distributions::update`] without a shape level: the touched cells and,
-/// with fusion, their minority neighbours, in the order met (a scan's cells
-/// come in runs along its surfaces, so consecutive inserts mostly share a
-/// tile of the table).
+/// with fusion, their minority neighbours (whose fused sums include them,
+/// §IV-A(3)), each once. A touched cell's 3 × 3 block of sums, fetched for
+/// its own distribution, also tells which of its neighbours are minority
+/// cells (at least one point, fewer than [`MIN_POINTS`]).
 fn update_own(
     map: &mut CellTable<Line>,
-    search: Search<'_>,
+    seen: &mut KeySet,
     cells: &CellTable<CellStats>,
     cell_size: f64,
     options: DistOptions,
     touched: &[CellKey],
 ) {
-    let keys = with_minority_neighbours(search, options, touched, |_| true);
-    own_distributions(cells, cell_size, options, &keys, |key, g| match g {
+    let mut cursor = cells.cursor();
+    let none = CellStats::default();
+    let mut neighbours = Vec::with_capacity(touched.len());
+    let mut batch = OwnBatch::new(cell_size, options, |key, g| match g {
         Some(g) => map.insert(key, Line(g)),
         None => {
             map.remove(key);
         }
     });
+    for &key in touched {
+        if !options.fuse_minority {
+            if seen.insert(key) {
+                batch.push(key, cursor.get(key).copied());
+            }
+            continue;
+        }
+        let block = cursor.block3(key, &none);
+        if seen.insert(key) {
+            batch.push(key, fused_or_own(&block, cell_size));
+        }
+        // The minority neighbours as bits (no branch per neighbour), then
+        // each of them.
+        let mut bits = block.iter().enumerate().fold(0u16, |b, (i, c)| {
+            b | u16::from(c.count.wrapping_sub(1) < MIN_POINTS - 1) << i
+        }) & !(1 << 4);
+        while bits != 0 {
+            let i = bits.trailing_zeros() as i32;
+            bits &= bits - 1;
+            let n = key.offset(i % 3 - 1, i / 3 - 1);
+            if seen.insert(n) {
+                neighbours.push(n);
+            }
+        }
+    }
+    for n in neighbours {
+        batch.push(n, own_stats(&mut cursor, cell_size, options, n));
+    }
+    batch.finish();
 }
 
 /// What the minority-neighbour search of one update reads and keeps track
@@ -524,8 +551,7 @@ fn shape_of_ancestor(s: Shape<'_>, at: CellKey, options: DistOptions) -> Option<
 
 /// The sums the paper's distribution of cell `key` comes from (`None`
 /// when it has no points): its own, or for a minority cell with fusion
-/// (§IV-A(3)) those of its 3 × 3 block about its centre (see
-/// [`crate::gather`]).
+/// (§IV-A(3)) those of its 3 × 3 block about its centre ([`fused_or_own`]).
 #[inline]
 fn own_stats(
     cursor: &mut Cursor<'_, CellStats>,
@@ -537,43 +563,107 @@ fn own_stats(
         return cursor.get(key).copied();
     }
     let none = CellStats::default();
-    let block = cursor.block3(key, &none);
-    // A cell with points has a count; `none` has none.
+    fused_or_own(&cursor.block3(key, &none), cell_size)
+}
+
+/// With fusion, the sums a cell's distribution comes from, from its 3 × 3
+/// block (row by row, empty sums for a cell without points): `None` when
+/// the cell itself has no points, its own sums with at least
+/// [`MIN_POINTS`], else the block's about its centre (see
+/// [`crate::gather`]).
+#[inline]
+fn fused_or_own(block: &[&CellStats; 9], cell_size: f64) -> Option<CellStats> {
+    // A cell with points has a count; empty sums have none.
     let own = block[4];
     if own.count == 0 {
         None
     } else if own.count >= MIN_POINTS {
         Some(*own)
     } else {
-        Some(gather::block3(&block, cell_size))
+        Some(gather::block3(block, cell_size))
     }
 }
 
 /// The paper's distribution of each cell of `keys` under `options`, from
-/// the sums alone: eq. (7) expanded by eq. (8) ([`own_stats`]'s sums),
-/// [`moments::BATCH`] cells at a time; `emit` takes each key with its
+/// the sums alone ([`own_stats`]); `emit` takes each key with its
 /// distribution (`None`: it has none), in order.
 fn own_distributions(
     cells: &CellTable<CellStats>,
     cell_size: f64,
     options: DistOptions,
     keys: &[CellKey],
-    mut emit: impl FnMut(CellKey, Option<Gaussian>),
+    emit: impl FnMut(CellKey, Option<Gaussian>),
 ) {
     let mut cursor = cells.cursor();
-    let mut stats = StatsBatch::default();
-    let mut out = GaussBatch::default();
-    for batch in keys.chunks(moments::BATCH) {
-        let mut present = [false; moments::BATCH];
-        for ((l, &key), p) in batch.iter().enumerate().zip(present.iter_mut()) {
-            let s = own_stats(&mut cursor, cell_size, options, key);
+    let mut batch = OwnBatch::new(cell_size, options, emit);
+    for &key in keys {
+        batch.push(key, own_stats(&mut cursor, cell_size, options, key));
+    }
+    batch.finish();
+}
+
+/// Cells waiting for their distributions: eq. (7) expanded by eq. (8) from
+/// their sums, [`moments::BATCH`] cells at a time ([`moments::gaussians`]);
+/// `emit` takes each key with its distribution, in the order pushed.
+struct OwnBatch<F: FnMut(CellKey, Option<Gaussian>)> {
+    cell_size: f64,
+    options: DistOptions,
+    keys: [CellKey; moments::BATCH],
+    present: [bool; moments::BATCH],
+    len: usize,
+    stats: StatsBatch,
+    out: GaussBatch,
+    emit: F,
+}
+
+impl<F: FnMut(CellKey, Option<Gaussian>)> OwnBatch<F> {
+    fn new(cell_size: f64, options: DistOptions, emit: F) -> Self {
+        Self {
+            cell_size,
+            options,
+            keys: [CellKey { ix: 0, iy: 0 }; moments::BATCH],
+            present: [false; moments::BATCH],
+            len: 0,
+            stats: StatsBatch::default(),
+            out: GaussBatch::default(),
+            emit,
+        }
+    }
+
+    /// Cell `key`, whose distribution comes from the sums `s` about its
+    /// centre (`None`: it has no points).
+    #[inline]
+    fn push(&mut self, key: CellKey, s: Option<CellStats>) {
+        if self.len == moments::BATCH {
+            self.flush();
+        }
+        let l = self.len;
+        self.stats
+            .set(l, &s.unwrap_or_default(), key.center(self.cell_size));
+        if let (Some(k), Some(p)) = (self.keys.get_mut(l), self.present.get_mut(l)) {
+            *k = key;
             *p = s.is_some();
-            stats.set(l, &s.unwrap_or_default(), key.center(cell_size));
         }
-        moments::gaussians(&stats, options.sigma_floor, options.expansion, &mut out);
-        for ((l, &key), p) in batch.iter().enumerate().zip(present) {
-            emit(key, out.get(l).filter(|_| p));
+        self.len += 1;
+    }
+
+    fn flush(&mut self) {
+        let (floor, k) = (self.options.sigma_floor, self.options.expansion);
+        moments::gaussians(&self.stats, floor, k, &mut self.out);
+        for (l, (&key, &p)) in self
+            .keys
+            .iter()
+            .zip(&self.present)
+            .enumerate()
+            .take(self.len)
+        {
+            (self.emit)(key, self.out.get(l).filter(|_| p));
         }
+        self.len = 0;
+    }
+
+    fn finish(mut self) {
+        self.flush();
     }
 }
 

@@ -306,13 +306,24 @@ impl<T> CellTable<T> {
     pub fn cursor(&self) -> Cursor<'_, T> {
         Cursor {
             table: self,
-            last: [None; 4],
+            keys: [NEVER; 4],
+            tiles: [NONE; 4],
         }
     }
 }
 
-/// A tile index and its tile, if it has one.
-type Remembered = Option<((i32, i32), Option<u32>)>;
+/// A tile index packed into one word (one compare).
+#[inline(always)]
+fn packed(tile: (i32, i32)) -> u64 {
+    (u64::from(tile.0 as u32) << 32) | u64::from(tile.1 as u32)
+}
+
+/// No tile index packs to this: |index| ≤ 2²⁷ for keys within
+/// [`crate::key::MAX_INDEX`], never `i32::MIN`.
+const NEVER: u64 = 0x8000_0000_8000_0000;
+
+/// No tile (out of the slots' range).
+const NONE: u32 = u32::MAX;
 
 /// Reads a [`CellTable`] remembering the last tile looked up of each parity
 /// of its index (`tx mod 2`, `ty mod 2`), so runs of look-ups in one tile
@@ -322,7 +333,10 @@ type Remembered = Option<((i32, i32), Option<u32>)>;
 #[derive(Debug)]
 pub struct Cursor<'a, T> {
     table: &'a CellTable<T>,
-    last: [Remembered; 4],
+    /// Per parity: the packed index of the tile remembered ([`NEVER`]:
+    /// none yet), and its tile ([`NONE`]: the table has none there).
+    keys: [u64; 4],
+    tiles: [u32; 4],
 }
 
 impl<'a, T> Cursor<'a, T> {
@@ -330,36 +344,55 @@ impl<'a, T> Cursor<'a, T> {
     #[inline(always)]
     pub fn get(&mut self, key: CellKey) -> Option<&'a T> {
         let (tile, slot) = split(key);
-        let parity = ((tile.0 & 1) | ((tile.1 & 1) << 1)) as usize;
-        let t = match self.last.get(parity).copied().flatten() {
-            Some((k, t)) if k == tile => t,
-            _ => self.find_tile(tile, parity),
-        };
-        self.table.value_at(t?, slot)
+        let t = self.tile_index(tile);
+        self.table
+            .value_at(self.table.slots.get(t as usize).map(|_| t)?, slot)
+    }
+
+    /// The tile of index `tile` ([`NONE`] where the table has none), through
+    /// the remembered tiles.
+    #[inline(always)]
+    fn tile_index(&mut self, tile: (i32, i32)) -> u32 {
+        let parity = ((tile.0 & 1) | ((tile.1 & 1) << 1)) as usize & 3;
+        if self.keys[parity] == packed(tile) {
+            self.tiles[parity]
+        } else {
+            self.find_tile(tile, parity)
+        }
     }
 
     /// The slots of tile `tile`, if it has any (through the remembered
     /// tiles, as [`Cursor::get`]).
     #[inline(always)]
     fn tile_slots(&mut self, tile: (i32, i32)) -> Option<&'a Tile> {
-        let parity = ((tile.0 & 1) | ((tile.1 & 1) << 1)) as usize;
-        let t = match self.last.get(parity).copied().flatten() {
-            Some((k, t)) if k == tile => t,
-            _ => self.find_tile(tile, parity),
-        };
-        self.table.slots.get(t? as usize)
+        let t = self.tile_index(tile);
+        self.table.slots.get(t as usize)
     }
 
-    /// The value in slot `slot` of `tile`, or `none` (an empty slot's index
-    /// is out of the values' range: one compare, no branch on the pattern
-    /// of occupied cells).
+    /// The value at index `i` of the values (a slot's content), or `none`
+    /// for an empty slot ([`EMPTY`], out of the values' range): a select,
+    /// not a branch, on the irregular pattern of occupied cells.
+    #[inline(always)]
+    fn value_or<'b>(&self, i: u32, none: &'b T) -> &'b T
+    where
+        'a: 'b,
+    {
+        let values = &self.table.values;
+        let i = i as usize;
+        match values.get(i.min(values.len().saturating_sub(1))) {
+            Some(v) => std::hint::select_unpredictable(i < values.len(), v, none),
+            None => none,
+        }
+    }
+
+    /// The value in slot `slot` of `tile`, or `none` (see
+    /// [`Cursor::value_or`]).
     #[inline(always)]
     fn in_tile<'b>(&self, tile: &Tile, slot: usize, none: &'b T) -> &'b T
     where
         'a: 'b,
     {
-        let i = tile.get(slot).copied().unwrap_or(EMPTY);
-        self.table.values.get(i as usize).unwrap_or(none)
+        self.value_or(tile.get(slot).copied().unwrap_or(EMPTY), none)
     }
 
     /// The values of the 3 × 3 block of cells around `key`, row by row
@@ -378,13 +411,25 @@ impl<'a, T> Cursor<'a, T> {
         let (tx1, ty1) = ((x0 + 2) >> TILE_BITS, (y0 + 2) >> TILE_BITS);
         let tiles = [(tx0, ty0), (tx1, ty0), (tx0, ty1), (tx1, ty1)]
             .map(|t| self.tile_slots(t).unwrap_or(&NO_TILE));
+        // Per column and per row: which tile (bit 0: right, bit 1: above)
+        // and the slot's part within it.
+        let cols: [(usize, i32); 3] = std::array::from_fn(|c| {
+            (
+                usize::from((x0 + c as i32) >> TILE_BITS != tx0),
+                (x0 + c as i32) & MASK,
+            )
+        });
+        let rows: [(usize, i32); 3] = std::array::from_fn(|r| {
+            (
+                usize::from((y0 + r as i32) >> TILE_BITS != ty0) << 1,
+                ((y0 + r as i32) & MASK) * TILE,
+            )
+        });
         let mut out = [none; 9];
-        for (i, o) in (0..9).zip(out.iter_mut()) {
-            let (x, y) = (x0 + i % 3, y0 + i / 3);
-            let which =
-                usize::from(x >> TILE_BITS != tx0) | usize::from(y >> TILE_BITS != ty0) << 1;
-            let slot = ((y & MASK) * TILE + (x & MASK)) as usize;
-            *o = self.in_tile(tiles[which & 3], slot, none);
+        for (i, o) in out.iter_mut().enumerate() {
+            let ((tc, sc), (tr, sr)) = (cols[i % 3], rows[i / 3]);
+            let slot = tiles[(tc | tr) & 3][((sr + sc) & (TILE * TILE - 1)) as usize];
+            *o = self.value_or(slot, none);
         }
         out
     }
@@ -418,11 +463,11 @@ impl<'a, T> Cursor<'a, T> {
     /// The hashed look-up of a tile not remembered (kept out of line, so
     /// the common path inlines into the matcher's loop).
     #[inline(never)]
-    fn find_tile(&mut self, tile: (i32, i32), parity: usize) -> Option<u32> {
-        let t = self.table.tiles.get(&tile).copied();
-        if let Some(r) = self.last.get_mut(parity) {
-            *r = Some((tile, t));
-        }
+    fn find_tile(&mut self, tile: (i32, i32), parity: usize) -> u32 {
+        let t = self.table.tiles.get(&tile).copied().unwrap_or(NONE);
+        let p = parity & 3;
+        self.keys[p] = packed(tile);
+        self.tiles[p] = t;
         t
     }
 }

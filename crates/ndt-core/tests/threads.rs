@@ -14,7 +14,7 @@ const SETS: usize = 26;
 fn options(i: usize) -> MatchOptions {
     MatchOptions {
         expansion: 2.0 + i as f64,
-        fuse_minority: i % 2 == 0,
+        fuse_minority: i.is_multiple_of(2),
         levels: Some(1),
         rotation_search: 0.0,
         ..MatchOptions::default()

@@ -81,7 +81,7 @@ pub type CellTable = FxHashMap<CellKey, CellInfo>;
 /// `true` when the periodic checks (b-1 and c) run after scan `scan`
 /// (1-based): every `interval`-th scan.
 pub fn check_due(scan: u64, interval: u32) -> bool {
-    interval > 0 && scan % u64::from(interval) == 0
+    interval > 0 && scan.is_multiple_of(u64::from(interval))
 }
 
 /// §V step c: the cells that scan `scan`'s check deletes: those that have
