@@ -7,12 +7,20 @@
 //! options against a map that takes every third scan and loses every 17th
 //! cell (in key order) every 50 scans; prints a hash of every pose's and
 //! score's bits, so two builds can be compared for bit-identical results.
+//! `replay <dump> mapwork [reps]`: the work of the loop's matching grid
+//! alone. `Odometry` runs over the log once to find the scans it inserts
+//! and their poses; then, `reps` times, a new grid takes them in order
+//! (its distributions prepared by a match before the second insertion, as
+//! in the loop) and loses the cells of the loop's map window, as
+//! `Odometry` does; prints the time of the inserts and of the removals.
 
+use std::collections::VecDeque;
 use std::error::Error;
 use std::time::Instant;
 
 use ndt_core::odometry::{Odometry, OdometryConfig};
-use ndt_core::{points_from_ranges, MatchOptions, NdtGrid, Pose2};
+use ndt_core::{points_from_ranges, CellKey, MatchOptions, NdtGrid, Pose2};
+use rustc_hash::FxHashMap;
 
 type Scan = (Vec<f64>, Vec<f64>, Option<Pose2>);
 
@@ -120,9 +128,64 @@ fn matchhash(scans: &[Scan]) -> Result<(), Box<dyn Error>> {
     Ok(())
 }
 
+fn mapwork(scans: &[Scan], reps: usize) -> Result<(), Box<dyn Error>> {
+    let config = OdometryConfig::default();
+    let mut odo = Odometry::new(config)?;
+    let mut inserted = Vec::new();
+    for (r, a, o) in scans {
+        if odo.step(r, a, *o)?.inserted {
+            let points = points_from_ranges(r, a, config.min_range, config.max_range)?;
+            inserted.push((points, odo.poses().last().copied().unwrap_or_default()));
+        }
+    }
+    for _ in 0..reps {
+        let mut grid = NdtGrid::new(config.cell_size)?;
+        // The map window as `Odometry` keeps it: the insertion that last hit
+        // each cell, and the cells of each of the last `map_window` ones.
+        let mut stamps: FxHashMap<CellKey, usize> = FxHashMap::default();
+        let mut window: VecDeque<(usize, Vec<CellKey>)> = VecDeque::new();
+        let (mut insert, mut remove) = (0.0, 0.0);
+        for (n, (points, pose)) in inserted.iter().enumerate() {
+            if n == 1 {
+                // A loop has matched before its second insertion.
+                grid.match_scan(points, *pose, &config.matcher)?;
+            }
+            let t = Instant::now();
+            let touched = grid.insert(points, *pose)?;
+            insert += t.elapsed().as_secs_f64();
+            for &key in &touched {
+                stamps.insert(key, n);
+            }
+            window.push_back((n, touched));
+            let mut stale = Vec::new();
+            while window.len() > config.map_window {
+                let Some((m, keys)) = window.pop_front() else {
+                    break;
+                };
+                stale.extend(keys.into_iter().filter(|k| stamps.get(k) == Some(&m)));
+            }
+            for key in &stale {
+                stamps.remove(key);
+            }
+            let t = Instant::now();
+            grid.remove_cells(&stale);
+            remove += t.elapsed().as_secs_f64();
+        }
+        let n = inserted.len().max(1) as f64;
+        println!(
+            "{} insertions: insert {insert:.3} s ({:.1} us each), window removals {remove:.3} s ({:.1} us each); {} cells",
+            inserted.len(),
+            1e6 * insert / n,
+            1e6 * remove / n,
+            grid.len()
+        );
+    }
+    Ok(())
+}
+
 fn main() -> Result<(), Box<dyn Error>> {
     let args: Vec<String> = std::env::args().collect();
-    let usage = "usage: replay <dump> odometry [reps] [inline] | replay <dump> matchhash";
+    let usage = "usage: replay <dump> odometry [reps] [inline] | matchhash | mapwork [reps]";
     let (Some(path), Some(mode)) = (args.get(1), args.get(2)) else {
         return Err(usage.into());
     };
@@ -134,6 +197,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             args.get(4).is_some_and(|s| s == "inline"),
         ),
         "matchhash" => matchhash(&scans),
+        "mapwork" => mapwork(&scans, args.get(3).map_or(Ok(3), |s| s.parse())?),
         _ => Err(usage.into()),
     }
 }
