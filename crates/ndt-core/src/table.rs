@@ -62,8 +62,11 @@ pub struct CellTable<T> {
     /// alignment (the matcher's distributions do).
     values: Vec<T>,
     keys: Vec<CellKey>,
-    /// The tile of the last insert (runs of inserts in one tile skip the hash).
-    last_insert: Option<((i32, i32), u32)>,
+    /// The tile of the last insert of each parity of the tile index (packed,
+    /// [`NEVER`]: none), so runs of inserts in one tile, and inserts around
+    /// one cell across tile borders, skip the hash.
+    insert_keys: [u64; 4],
+    insert_tiles: [u32; 4],
 }
 
 /// A copy with the original's spare capacity: inserts into a clone grow
@@ -84,7 +87,8 @@ impl<T: Clone> Clone for CellTable<T> {
             free_tiles: self.free_tiles.clone(),
             values,
             keys,
-            last_insert: self.last_insert,
+            insert_keys: self.insert_keys,
+            insert_tiles: self.insert_tiles,
         }
     }
 }
@@ -116,7 +120,8 @@ impl<T> Default for CellTable<T> {
             free_tiles: Vec::new(),
             values: Vec::new(),
             keys: Vec::new(),
-            last_insert: None,
+            insert_keys: [NEVER; 4],
+            insert_tiles: [NONE; 4],
         }
     }
 }
@@ -190,7 +195,7 @@ impl<T> CellTable<T> {
         self.free_tiles.clear();
         self.values.clear();
         self.keys.clear();
-        self.last_insert = None;
+        self.insert_keys = [NEVER; 4];
     }
 
     /// Sets the value of `key` (replacing any). Unlike
@@ -221,8 +226,11 @@ impl<T> CellTable<T> {
     /// The tile of `key` (a new one when it has none) and its slot there.
     fn tile_of(&mut self, key: CellKey) -> (u32, usize) {
         let (tile, slot) = split(key);
-        let cached = self.last_insert.filter(|&(k, _)| k == tile).map(|(_, t)| t);
-        let t = match cached.or_else(|| self.tiles.get(&tile).copied()) {
+        let parity = ((tile.0 & 1) | ((tile.1 & 1) << 1)) as usize & 3;
+        if self.insert_keys[parity] == packed(tile) {
+            return (self.insert_tiles[parity], slot);
+        }
+        let t = match self.tiles.get(&tile).copied() {
             Some(t) => t,
             None => {
                 let t = match self.free_tiles.pop() {
@@ -237,7 +245,8 @@ impl<T> CellTable<T> {
                 t
             }
         };
-        self.last_insert = Some((tile, t));
+        self.insert_keys[parity] = packed(tile);
+        self.insert_tiles[parity] = t;
         (t, slot)
     }
 
@@ -261,7 +270,10 @@ impl<T> CellTable<T> {
         self.used[t as usize] -= 1;
         if self.used[t as usize] == 0 {
             self.tiles.remove(&tile);
-            self.last_insert = None;
+            let parity = ((tile.0 & 1) | ((tile.1 & 1) << 1)) as usize & 3;
+            if self.insert_keys[parity] == packed(tile) {
+                self.insert_keys[parity] = NEVER;
+            }
             self.free_tiles.push(t);
         }
         // Keep the values contiguous: move the last one into the hole.
@@ -476,6 +488,28 @@ impl<'a, T> Cursor<'a, T> {
 mod tests {
     use super::*;
     use std::collections::HashMap;
+
+    /// A tile emptied by removals is freed and its storage reused by the
+    /// next new tile; inserts into the first tile again must not write
+    /// through a remembered tile number (a tile of either parity).
+    #[test]
+    fn emptied_tiles_are_forgotten_by_inserts() {
+        for (a, b) in [((0, 0), (16, 0)), ((9, 1), (1, 17)), ((-8, -8), (-24, 8))] {
+            let (ka, kb) = (CellKey { ix: a.0, iy: a.1 }, CellKey { ix: b.0, iy: b.1 });
+            let mut table = CellTable::default();
+            table.insert(ka, 1);
+            assert_eq!(table.remove(ka), Some(1));
+            table.insert(kb, 2);
+            table.insert(ka, 3);
+            assert_eq!((table.get(ka), table.get(kb)), (Some(&3), Some(&2)));
+            *table.get_or_default(ka) += 1;
+            assert_eq!(table.replace(kb, 5), Some(2));
+            assert_eq!(
+                (table.get(ka), table.get(kb), table.len()),
+                (Some(&4), Some(&5), 2)
+            );
+        }
+    }
 
     #[test]
     fn matches_a_hash_map_under_inserts_and_removes() {
