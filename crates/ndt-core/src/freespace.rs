@@ -99,8 +99,9 @@ impl FreeSpace {
         let origin = [pose.x, pose.y];
         let start = self.key("pose", 0, origin)?;
         let mut ends = Vec::with_capacity(points.len());
+        let sin_cos = pose.theta.sin_cos();
         for (index, p) in points.iter().enumerate() {
-            let w = pose.transform(nalgebra::Vector2::new(p[0], p[1]));
+            let w = pose.transform_with(sin_cos, nalgebra::Vector2::new(p[0], p[1]));
             ends.push(([w.x, w.y], self.key("points", index, [w.x, w.y])?));
         }
         for (end, end_key) in ends {

@@ -199,8 +199,9 @@ impl NdtGrid {
         check_finite("pose", &pose.to_array())?;
         check_points("points", points)?;
         let mut staged: Vec<(CellKey, Vector2<f64>)> = Vec::with_capacity(points.len());
+        let sin_cos = pose.theta.sin_cos();
         for (index, p) in points.iter().enumerate() {
-            let w = pose.transform(Vector2::new(p[0], p[1]));
+            let w = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
             let key = CellKey::of(w, self.inv_cell_size).ok_or(NdtError::CellIndexOverflow {
                 what: "points",
                 index,

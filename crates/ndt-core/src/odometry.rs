@@ -26,7 +26,7 @@ use crate::key::CellKey;
 use crate::mapper::{Mapper, MapperOptions};
 use crate::mapworker::{MapperHost, MapperView};
 use crate::matcher::{MatchOptions, MatchResult};
-use crate::ranges::points_from_ranges;
+use crate::ranges::BeamDirections;
 use crate::se2::Pose2;
 
 /// The default [`OdometryConfig::coarse_rotation_gate`].
@@ -313,6 +313,8 @@ pub struct Odometry {
     /// Score of eq. (1) per point of the last [`GATE_HISTORY`] accepted
     /// matches (see [`OdometryConfig::coarse_rotation_gate`]).
     scores: VecDeque<f64>,
+    /// The beams' directions, kept from scan to scan.
+    beams: BeamDirections,
 }
 
 impl Odometry {
@@ -338,6 +340,7 @@ impl Odometry {
             stamps: FxHashMap::default(),
             history: VecDeque::new(),
             scores: VecDeque::with_capacity(GATE_HISTORY + 1),
+            beams: BeamDirections::default(),
         })
     }
 
@@ -622,11 +625,13 @@ impl Odometry {
             // The cells this scan touched (the filter stores a subset of
             // them), each once.
             let inv = 1.0 / self.config.cell_size;
+            let sin_cos = pose.theta.sin_cos();
             let mut seen = rustc_hash::FxHashSet::default();
             points
                 .iter()
                 .filter_map(|p| {
-                    CellKey::of(pose.transform(nalgebra::Vector2::new(p[0], p[1])), inv)
+                    let w = pose.transform_with(sin_cos, nalgebra::Vector2::new(p[0], p[1]));
+                    CellKey::of(w, inv)
                 })
                 .filter(|k| seen.insert(*k))
                 .collect()
@@ -640,8 +645,9 @@ impl Odometry {
         self.mapper.update(checked, stale)
     }
 
-    fn valid_points(&self, ranges: &[f64], angles: &[f64]) -> Result<Vec<[f64; 2]>> {
-        points_from_ranges(ranges, angles, self.config.min_range, self.config.max_range)
+    fn valid_points(&mut self, ranges: &[f64], angles: &[f64]) -> Result<Vec<[f64; 2]>> {
+        let (lo, hi) = (self.config.min_range, self.config.max_range);
+        self.beams.points(ranges, angles, lo, hi)
     }
 
     /// The memory bound: the matching grid forgets the cells no scan of the

@@ -26,6 +26,22 @@ pub fn points_from_ranges(
     min_range: f64,
     max_range: f64,
 ) -> Result<Vec<[f64; 2]>> {
+    check_scan_and_limits(ranges, angles, min_range, max_range)?;
+    Ok(points_along(
+        ranges,
+        angles.iter().map(|a| a.sin_cos()),
+        min_range,
+        max_range,
+    ))
+}
+
+/// The checks of [`points_from_ranges`].
+fn check_scan_and_limits(
+    ranges: &[f64],
+    angles: &[f64],
+    min_range: f64,
+    max_range: f64,
+) -> Result<()> {
     check_beams(ranges, angles)?;
     if !(min_range.is_finite() && min_range >= 0.0) {
         return Err(NdtError::InvalidOption {
@@ -41,13 +57,103 @@ pub fn points_from_ranges(
             value: max_range,
         });
     }
-    Ok(ranges
+    Ok(())
+}
+
+/// The points of the valid ranges along the beams' `(sin a, cos a)`.
+fn points_along(
+    ranges: &[f64],
+    directions: impl Iterator<Item = (f64, f64)>,
+    min_range: f64,
+    max_range: f64,
+) -> Vec<[f64; 2]> {
+    ranges
         .iter()
-        .zip(angles)
+        .zip(directions)
         .filter(|(r, _)| r.is_finite() && **r >= min_range && **r < max_range && **r > 0.0)
-        .map(|(r, a)| {
-            let (s, c) = a.sin_cos();
-            [r * c, r * s]
-        })
-        .collect())
+        .map(|(r, (s, c))| [r * c, r * s])
+        .collect()
+}
+
+/// The beams' `(sin a, cos a)` of the last scan's angles, kept while the
+/// angles stay the same (a sensor's beams point the same way scan after
+/// scan): [`BeamDirections::points`] gives [`points_from_ranges`]'s points
+/// without a sine and cosine per beam and scan.
+#[derive(Debug, Clone, Default)]
+pub struct BeamDirections {
+    angles: Vec<f64>,
+    directions: Vec<(f64, f64)>,
+}
+
+impl BeamDirections {
+    /// [`points_from_ranges`] (the same checks and points, bit for bit).
+    pub fn points(
+        &mut self,
+        ranges: &[f64],
+        angles: &[f64],
+        min_range: f64,
+        max_range: f64,
+    ) -> Result<Vec<[f64; 2]>> {
+        check_scan_and_limits(ranges, angles, min_range, max_range)?;
+        let same = self.angles.len() == angles.len()
+            && self
+                .angles
+                .iter()
+                .zip(angles)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+        if !same {
+            self.angles.clear();
+            self.angles.extend_from_slice(angles);
+            self.directions.clear();
+            self.directions.extend(angles.iter().map(|a| a.sin_cos()));
+        }
+        Ok(points_along(
+            ranges,
+            self.directions.iter().copied(),
+            min_range,
+            max_range,
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The kept directions give `points_from_ranges`'s points bit for bit,
+    /// when the angles repeat and when they change (length or value), and
+    /// the same errors.
+    #[test]
+    fn kept_directions_give_the_same_points() {
+        let mut kept = BeamDirections::default();
+        let a1: Vec<f64> = (0..181).map(|i| f64::from(i - 90).to_radians()).collect();
+        let mut a2 = a1.clone();
+        a2[7] += 1e-12;
+        let a3: Vec<f64> = a1[..100].to_vec();
+        for (k, angles) in [&a1, &a1, &a2, &a1, &a3, &a3, &a1].into_iter().enumerate() {
+            let ranges: Vec<f64> = (0..angles.len())
+                .map(|i| match (i + k) % 9 {
+                    0 => f64::NAN,
+                    1 => 0.0,
+                    2 => 30.0,
+                    _ => 0.1 + 0.37 * (i + k) as f64 % 25.0,
+                })
+                .collect();
+            let want = points_from_ranges(&ranges, angles, 0.05, 30.0).unwrap_or_default();
+            let got = kept.points(&ranges, angles, 0.05, 30.0).unwrap_or_default();
+            assert!(!want.is_empty());
+            let bits = |p: &[[f64; 2]]| -> Vec<u64> {
+                p.iter()
+                    .flat_map(|q| [q[0].to_bits(), q[1].to_bits()])
+                    .collect()
+            };
+            assert_eq!(bits(&got), bits(&want), "scan {k}");
+        }
+        let short = [1.0, 2.0];
+        assert_eq!(
+            kept.points(&short, &a1, 0.0, 30.0)
+                .map_err(|e| e.to_string()),
+            points_from_ranges(&short, &a1, 0.0, 30.0).map_err(|e| e.to_string())
+        );
+    }
 }

@@ -42,6 +42,19 @@ impl Beam {
     /// A beam of range `range` \[m\] and angle `angle` \[rad\] seen from the
     /// sensor pose `pose` (`T_map_scan`).
     pub fn new(index: usize, range: f64, angle: f64, pose: crate::Pose2) -> Self {
+        Self::seen_from(index, range, angle, pose, pose.theta.sin_cos())
+    }
+
+    /// [`Beam::new`] with the pose's `(sin θ, cos θ)` given (the same for
+    /// every beam of a scan).
+    #[inline]
+    pub fn seen_from(
+        index: usize,
+        range: f64,
+        angle: f64,
+        pose: crate::Pose2,
+        pose_sin_cos: (f64, f64),
+    ) -> Self {
         let (s, c) = angle.sin_cos();
         let local = Vector2::new(range * c, range * s);
         Self {
@@ -49,7 +62,7 @@ impl Beam {
             range,
             angle,
             local,
-            world: pose.transform(local),
+            world: pose.transform_with(pose_sin_cos, local),
         }
     }
 }

@@ -232,11 +232,12 @@ impl MapFilter {
         let (lo, hi) = (self.options.min_range, self.options.max_range);
         let inv_cell = 1.0 / grid.cell_size();
         let mut beams = Vec::with_capacity(ranges.len());
+        let sin_cos = pose.theta.sin_cos();
         for (index, (&r, &a)) in ranges.iter().zip(angles).enumerate() {
             if !(r.is_finite() && r > 0.0 && r >= lo && r < hi) {
                 continue;
             }
-            let beam = Beam::new(index, r, a, pose);
+            let beam = Beam::seen_from(index, r, a, pose, sin_cos);
             if CellKey::of(beam.world, inv_cell).is_none() {
                 return Err(NdtError::CellIndexOverflow {
                     what: "ranges",
