@@ -237,8 +237,8 @@ fn cell_keys(
             // low bits (exact for |v| < 2⁵¹; lanes out of range are not
             // valid anyway), then one down where that is above v.
             let (rx, ry) = (vx + ROUND, vy + ROUND);
-            let ix = (rx.to_bits() as i32) - i32::from(rx - ROUND > vx);
-            let iy = (ry.to_bits() as i32) - i32::from(ry - ROUND > vy);
+            let ix = (rx.to_bits() as i32).wrapping_sub(i32::from(rx - ROUND > vx));
+            let iy = (ry.to_bits() as i32).wrapping_sub(i32::from(ry - ROUND > vy));
             fresh.ix[l] = ix;
             fresh.iy[l] = iy;
             eq[l] = ix == kept.ix[l] && iy == kept.iy[l];
@@ -446,6 +446,16 @@ mod tests {
             f64::NAN,
             f64::INFINITY,
             f64::NEG_INFINITY,
+            // Beyond 2⁵² the rounding is no longer exact: not valid, and no
+            // overflow in the arithmetic either.
+            4.5e15,
+            -4.5e15,
+            9.1e15 + 3.0,
+            -9.1e15 - 3.0,
+            1e300,
+            -1e300,
+            f64::MAX,
+            f64::MIN,
         ];
         for _ in 0..2000 {
             let v: f64 = rng.random_range(-1e4..1e4);
