@@ -126,7 +126,7 @@ impl CellMaskReader<'_> {
     /// The word of `block` (0 when the mask has none).
     #[inline(always)]
     fn word(&mut self, block: (i32, i32)) -> u64 {
-        let parity = ((block.0 & 1) | ((block.1 & 1) << 1)) as usize;
+        let parity = crate::table::parity(block);
         match self.last.get(parity).copied().flatten() {
             Some((b, w)) if b == block => w,
             _ => self.find(block, parity),

@@ -91,10 +91,16 @@ impl Distributions {
                 for at in s.cells().keys() {
                     store.set_ancestor(at, shape_of_ancestor(s, at, options));
                 }
+                let mut private = Vec::new();
                 for (key, own) in cells.iter() {
                     let at = crate::pyramid::coarse_key(key, s.depth());
-                    set_cell(&mut store, cells, cell_size, options, at, key, own);
+                    if set_cell(&mut store, cell_size, at, key, own) {
+                        private.push(key);
+                    }
                 }
+                own_distributions(cells, cell_size, options, &private, |key, g| {
+                    store.set_own(key, g);
+                });
                 Store::Shaped(store)
             }
         };
@@ -331,13 +337,10 @@ fn update_own(
         }
         // The minority neighbours as bits (no branch per neighbour), then
         // each of them.
-        let mut bits = block.iter().enumerate().fold(0u16, |b, (i, c)| {
-            b | u16::from(c.count.wrapping_sub(1) < MIN_POINTS - 1) << i
-        }) & !(1 << 4);
-        while bits != 0 {
-            let i = bits.trailing_zeros() as i32;
-            bits &= bits - 1;
-            let n = key.offset(i % 3 - 1, i / 3 - 1);
+        let bits = block.iter().enumerate().fold(0u16, |b, (i, c)| {
+            b | u16::from(minority_count(c.count)) << i
+        });
+        for n in block_cells(key, bits & !(1 << 4)) {
             if seen.insert(n) {
                 neighbours.push(n);
             }
@@ -360,7 +363,28 @@ struct Search<'a> {
 /// [`MIN_POINTS`] points; a cell without points is none).
 #[inline]
 fn is_minority(own: Option<&CellStats>) -> bool {
-    own.is_some_and(|s| s.count < MIN_POINTS)
+    own.is_some_and(|s| minority_count(s.count))
+}
+
+/// Whether `count` points make a minority cell: at least one, fewer than
+/// [`MIN_POINTS`] (one compare, no branch).
+#[inline(always)]
+fn minority_count(count: u64) -> bool {
+    count.wrapping_sub(1) < MIN_POINTS - 1
+}
+
+/// The cells of a 3 × 3 block around `key` whose bits are set in `bits`
+/// (bit `3 · (dy + 1) + (dx + 1)` for the cell at offset `(dx, dy)`), row
+/// by row.
+#[inline]
+fn block_cells(key: CellKey, mut bits: u16) -> impl Iterator<Item = CellKey> {
+    std::iter::from_fn(move || {
+        (bits != 0).then(|| {
+            let i = bits.trailing_zeros() as i32;
+            bits &= bits - 1;
+            key.offset(i % 3 - 1, i / 3 - 1)
+        })
+    })
 }
 
 /// `touched`, and with fusion every minority neighbour of a touched cell
@@ -381,12 +405,8 @@ fn with_minority_neighbours(
         }
         if options.fuse_minority {
             // The minority cells of the 3 × 3 block but the cell itself (met
-            // above), row by row.
-            let mut bits = reader.block3(key) & !(1 << 4);
-            while bits != 0 {
-                let i = bits.trailing_zeros() as i32;
-                bits &= bits - 1;
-                let n = key.offset(i % 3 - 1, i / 3 - 1);
+            // above).
+            for n in block_cells(key, reader.block3(key) & !(1 << 4)) {
                 if wanted(n) && seen.insert(n) {
                     rest.push(n);
                 }
@@ -425,9 +445,15 @@ fn update_shaped(
     }
     seen.clear();
     if !changed.is_empty() {
+        let mut private = Vec::new();
         for (at, key, own) in s.descendants(&changed) {
-            set_cell(store, cells, cell_size, options, at, key, own);
+            if set_cell(store, cell_size, at, key, own) {
+                private.push(key);
+            }
         }
+        own_distributions(cells, cell_size, options, &private, |key, g| {
+            store.set_own(key, g);
+        });
     }
     // What an ancestor is now, `None` when it changed kind (its cells are
     // set above); the last one asked about remembered.
@@ -509,25 +535,22 @@ impl AncestorKinds<'_> {
 }
 
 /// Sets cell `key` (sums `own`) under ancestor `at` as the ancestor's kind
-/// says (see [`Ancestor`]).
+/// says (see [`Ancestor`]); `true` when the cell takes a distribution of its
+/// own (an unshaped ancestor), which the caller gives it, with the others',
+/// by [`own_distributions`].
 fn set_cell(
     store: &mut ShapedStore,
-    cells: &CellTable<CellStats>,
     cell_size: f64,
-    options: DistOptions,
     at: CellKey,
     key: CellKey,
     own: &CellStats,
-) {
+) -> bool {
     match store.ancestor(at) {
         Ancestor::Shaped(slot) => set_shared(store, cell_size, key, own, slot),
         Ancestor::Blocked => store.remove(key),
-        Ancestor::Unshaped => {
-            own_distributions(cells, cell_size, options, &[key], |key, g| {
-                store.set_own(key, g);
-            });
-        }
+        Ancestor::Unshaped => return true,
     }
+    false
 }
 
 /// Cell `key` (sums `own`) takes its own mean and the shared part `slot`

@@ -15,7 +15,7 @@ use crate::information::{own_cell_pairs, point_to_plane_information};
 use crate::key::CellKey;
 use crate::memo::LevelMemo;
 use crate::neighbor::nearest_in_rings_with;
-use crate::pairs::{evaluate_streaming, ScanPairs};
+use crate::pairs::{chunk_weights, evaluate_streaming, ScanPairs};
 use crate::quadratic::QuadraticModel;
 use crate::reduce::voxel_runs;
 use crate::score::{Order, ScoreTerms};
@@ -369,16 +369,31 @@ struct MatchPairs<'a> {
     points: &'a [[f64; 2]],
     weights: Option<&'a [f64]>,
     parallel: bool,
+    /// Pairs are kept (else every evaluation streams the points through a
+    /// small block, [`evaluate_streaming`]).
+    keep: bool,
     kept: Vec<(usize, Vec<ScanPairs<'a>>)>,
 }
 
 impl<'a> MatchPairs<'a> {
     fn new(points: &'a [[f64; 2]], weights: Option<&'a [f64]>, options: &MatchOptions) -> Self {
+        let parallel = options.parallel && points.len() >= PARALLEL_MIN_POINTS;
         Self {
             points,
             weights,
-            parallel: options.parallel && points.len() >= PARALLEL_MIN_POINTS,
+            parallel,
+            keep: parallel || points.len() <= KEPT_MAX_POINTS,
             kept: Vec::with_capacity(KEPT_LEVELS),
+        }
+    }
+
+    /// For a single evaluation: on one thread nothing kept (no storage for
+    /// the whole scan), the same terms.
+    fn once(points: &'a [[f64; 2]], options: &MatchOptions) -> Self {
+        let pairs = Self::new(points, None, options);
+        Self {
+            keep: pairs.parallel,
+            ..pairs
         }
     }
 
@@ -388,9 +403,9 @@ impl<'a> MatchPairs<'a> {
         let at = match self.kept.iter().position(|(l, _)| *l == level) {
             Some(at) => at,
             None if self.kept.len() >= KEPT_LEVELS => {
-                let coarsest = (0..self.kept.len())
-                    .max_by_key(|&i| self.kept.get(i).map_or(0, |k| k.0))
-                    .unwrap_or(0);
+                let coarsest = (self.kept.iter().enumerate())
+                    .max_by_key(|(_, (l, _))| *l)
+                    .map_or(0, |(i, _)| i);
                 if let Some(k) = self.kept.get_mut(coarsest) {
                     k.0 = level;
                 }
@@ -407,10 +422,7 @@ impl<'a> MatchPairs<'a> {
                     .chunks(chunk)
                     .enumerate()
                     .map(|(i, pts)| {
-                        let w = self
-                            .weights
-                            .and_then(|w| w.get(i * chunk..i * chunk + pts.len()));
-                        ScanPairs::new(pts, w)
+                        ScanPairs::new(pts, chunk_weights(self.weights, i, chunk, pts.len()))
                     })
                     .collect();
                 self.kept.push((level, segments));
@@ -444,7 +456,7 @@ impl<'a> MatchPairs<'a> {
             );
         }
         let radius = options.neighbor_search.then_some(options.search_radius);
-        if !self.parallel && self.points.len() > KEPT_MAX_POINTS {
+        if !self.keep {
             return evaluate_streaming(
                 dists,
                 self.points,
@@ -503,8 +515,7 @@ fn evaluate_block(
         .par_chunks(PARALLEL_CHUNK)
         .enumerate()
         .map(|(i, chunk)| {
-            let w =
-                weights.and_then(|w| w.get(i * PARALLEL_CHUNK..i * PARALLEL_CHUNK + chunk.len()));
+            let w = chunk_weights(weights, i, PARALLEL_CHUNK, chunk.len());
             evaluate_block_serial(dists, chunk, w, pose, inv_cell, options, order)
         })
         .collect();
@@ -876,7 +887,7 @@ impl NdtGrid {
         let dists = self
             .distributions(0, options.dist_options())
             .ok_or(NdtError::Empty { what: "levels" })?;
-        Ok(MatchPairs::new(points, None, options)
+        Ok(MatchPairs::once(points, options)
             .evaluate(&dists, pose, options, order)
             .terms)
     }

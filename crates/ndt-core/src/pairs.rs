@@ -187,13 +187,32 @@ pub fn evaluate_streaming(
     let scan = Scan::new(pose, order);
     let mut sums: LaneSums = [[0.0; LANES]; SUMS];
     let mut matched = 0;
-    let mut pairs = ScanPairs::new(points.get(..STREAM_BLOCK).unwrap_or(points), None);
+    let mut pairs: Option<ScanPairs<'_>> = None;
     for (i, block) in points.chunks(STREAM_BLOCK).enumerate() {
-        let w = weights.and_then(|w| w.get(i * STREAM_BLOCK..i * STREAM_BLOCK + block.len()));
-        pairs.bind(block, w);
-        matched += pairs.accumulate(dists, &scan, inv_cell, search_radius, &mut sums);
+        let w = chunk_weights(weights, i, STREAM_BLOCK, block.len());
+        // The first block sizes the storage; the next ones reuse it.
+        let p = match pairs.as_mut() {
+            Some(p) => {
+                p.bind(block, w);
+                p
+            }
+            None => pairs.insert(ScanPairs::new(block, w)),
+        };
+        matched += p.accumulate(dists, &scan, inv_cell, search_radius, &mut sums);
     }
     pass_terms(&sums, matched)
+}
+
+/// The weights of chunk `index` (of `size` points; this one `len`) of a
+/// scan's points, if the scan has weights.
+#[inline]
+pub fn chunk_weights(
+    weights: Option<&[f64]>,
+    index: usize,
+    size: usize,
+    len: usize,
+) -> Option<&[f64]> {
+    weights.and_then(|w| w.get(index * size..index * size + len))
 }
 
 /// `1.5 · 2⁵²`: adding it rounds to an integer held in the low mantissa bits.

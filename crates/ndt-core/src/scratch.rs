@@ -35,7 +35,7 @@ impl KeySet {
     pub(crate) fn insert(&mut self, key: CellKey) -> bool {
         let block = (key.ix >> BLOCK_BITS, key.iy >> BLOCK_BITS);
         let bit = 1u64 << (((key.iy & MASK) << BLOCK_BITS) | (key.ix & MASK));
-        let parity = ((block.0 & 1) | ((block.1 & 1) << 1)) as usize;
+        let parity = crate::table::parity(block);
         let at = match self.last.get(parity).copied().flatten() {
             Some((b, at)) if b == block => at,
             _ => self.block(block, parity),

@@ -226,7 +226,7 @@ impl<T> CellTable<T> {
     /// The tile of `key` (a new one when it has none) and its slot there.
     fn tile_of(&mut self, key: CellKey) -> (u32, usize) {
         let (tile, slot) = split(key);
-        let parity = ((tile.0 & 1) | ((tile.1 & 1) << 1)) as usize & 3;
+        let parity = parity(tile);
         if self.insert_keys[parity] == packed(tile) {
             return (self.insert_tiles[parity], slot);
         }
@@ -270,7 +270,7 @@ impl<T> CellTable<T> {
         self.used[t as usize] -= 1;
         if self.used[t as usize] == 0 {
             self.tiles.remove(&tile);
-            let parity = ((tile.0 & 1) | ((tile.1 & 1) << 1)) as usize & 3;
+            let parity = parity(tile);
             if self.insert_keys[parity] == packed(tile) {
                 self.insert_keys[parity] = NEVER;
             }
@@ -324,6 +324,13 @@ impl<T> CellTable<T> {
     }
 }
 
+/// Which of the 4 remembered entries a tile (or block) index uses: its
+/// parity `(x mod 2) + 2 (y mod 2)`. Any 2 × 2 indices have one of each.
+#[inline(always)]
+pub(crate) fn parity(index: (i32, i32)) -> usize {
+    ((index.0 & 1) | ((index.1 & 1) << 1)) as usize & 3
+}
+
 /// A tile index packed into one word (one compare).
 #[inline(always)]
 fn packed(tile: (i32, i32)) -> u64 {
@@ -356,16 +363,18 @@ impl<'a, T> Cursor<'a, T> {
     #[inline(always)]
     pub fn get(&mut self, key: CellKey) -> Option<&'a T> {
         let (tile, slot) = split(key);
-        let t = self.tile_index(tile);
-        self.table
-            .value_at(self.table.slots.get(t as usize).map(|_| t)?, slot)
+        let slots = self.tile_slots(tile)?;
+        match slots.get(slot).copied() {
+            None | Some(EMPTY) => None,
+            Some(i) => self.table.values.get(i as usize),
+        }
     }
 
     /// The tile of index `tile` ([`NONE`] where the table has none), through
     /// the remembered tiles.
     #[inline(always)]
     fn tile_index(&mut self, tile: (i32, i32)) -> u32 {
-        let parity = ((tile.0 & 1) | ((tile.1 & 1) << 1)) as usize & 3;
+        let parity = parity(tile);
         if self.keys[parity] == packed(tile) {
             self.tiles[parity]
         } else {
