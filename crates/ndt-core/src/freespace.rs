@@ -80,7 +80,7 @@ impl FreeSpace {
 
     fn key(&self, what: &'static str, index: usize, p: [f64; 2]) -> Result<CellKey> {
         let v = nalgebra::Vector2::new(p[0], p[1]);
-        CellKey::of(v, self.inv).ok_or(NdtError::CellIndexOverflow {
+        CellKey::of(v, self.inv).ok_or_else(|| NdtError::CellIndexOverflow {
             what,
             index,
             x: p[0],

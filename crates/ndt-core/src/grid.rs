@@ -202,13 +202,15 @@ impl NdtGrid {
         let sin_cos = pose.theta.sin_cos();
         for (index, p) in points.iter().enumerate() {
             let w = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
-            let key = CellKey::of(w, self.inv_cell_size).ok_or(NdtError::CellIndexOverflow {
-                what: "points",
-                index,
-                x: w.x,
-                y: w.y,
-                limit: self.coordinate_limit(),
-            })?;
+            // Built only on failure (an eager error is dropped per point).
+            let key =
+                CellKey::of(w, self.inv_cell_size).ok_or_else(|| NdtError::CellIndexOverflow {
+                    what: "points",
+                    index,
+                    x: w.x,
+                    y: w.y,
+                    limit: self.coordinate_limit(),
+                })?;
             staged.push((key, w));
         }
         Ok(StagedScan { points: staged })
