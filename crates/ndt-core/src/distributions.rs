@@ -317,7 +317,6 @@ fn update_own(
 ) {
     let mut cursor = cells.cursor();
     let none = CellStats::default();
-    let mut neighbours = Vec::with_capacity(touched.len());
     let mut batch = OwnBatch::new(cell_size, options, |key, g| match g {
         Some(g) => map.insert(key, Line(g)),
         None => {
@@ -336,18 +335,16 @@ fn update_own(
             batch.push(key, fused_or_own(&block, cell_size));
         }
         // The minority neighbours as bits (no branch per neighbour), then
-        // each of them.
+        // each of them, now: their blocks lie in the tiles just read (the
+        // sums are all final, so the order changes no distribution).
         let bits = block.iter().enumerate().fold(0u16, |b, (i, c)| {
             b | u16::from(minority_count(c.count)) << i
         });
         for n in block_cells(key, bits & !(1 << 4)) {
             if seen.insert(n) {
-                neighbours.push(n);
+                batch.push(n, own_stats(&mut cursor, cell_size, options, n));
             }
         }
-    }
-    for n in neighbours {
-        batch.push(n, own_stats(&mut cursor, cell_size, options, n));
     }
     batch.finish();
 }
