@@ -29,8 +29,7 @@ const BEAMS: [usize; 4] = [180, 361, 683, 2000];
 const CELLS: [f64; 2] = [0.02, 0.2];
 
 fn scan(beams: usize, pose: Pose2, seed: u64) -> Vec<[f64; 2]> {
-    let fov = if beams >= 683 { 240f64 } else { 180f64 };
-    common::scan(&common::room(), pose, beams, fov.to_radians(), 0.01, seed)
+    common::room_scan(beams, pose, seed)
 }
 
 fn map(beams: usize, cell: f64) -> NdtGrid {

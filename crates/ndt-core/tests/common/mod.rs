@@ -82,3 +82,11 @@ pub fn scan(
 pub fn urg_scan(walls: &[Segment], pose: Pose2, noise: f64, seed: u64) -> Vec<[f64; 2]> {
     scan(walls, pose, 683, 240f64.to_radians(), noise, seed)
 }
+
+/// A scan of [`room`] from `pose` with `beams` beams and 1 cm range noise, as
+/// the benches take them: over 240° from 683 beams on (a URG-04LX), else
+/// over 180° (a SICK).
+pub fn room_scan(beams: usize, pose: Pose2, seed: u64) -> Vec<[f64; 2]> {
+    let fov = if beams >= 683 { 240f64 } else { 180f64 };
+    scan(&room(), pose, beams, fov.to_radians(), 0.01, seed)
+}

@@ -1,0 +1,60 @@
+//! Profiling harness: criterion's `insert_loop` group (`benches/core.rs`)
+//! as a plain program, for instruction counts under valgrind.
+//!
+//! `insert_loop [beams] [n]` (default 683 beams, 300 rounds): a 2 cm grid
+//! takes 8 simulated scans of the tests' room, then `n` times one of 64
+//! scans from a ring of poses is matched with the default options (so the
+//! distributions are built, as in a SLAM loop) and inserted; prints the
+//! mean time of an insert and of a match.
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use std::error::Error;
+use std::time::Instant;
+
+use ndt_core::{MatchOptions, NdtGrid, Pose2};
+
+/// The `i`-th positional argument as a number, `default` when absent.
+fn arg(i: usize, default: usize) -> Result<usize, Box<dyn Error>> {
+    match std::env::args().nth(i) {
+        Some(s) => Ok(s.parse()?),
+        None => Ok(default),
+    }
+}
+
+fn main() -> Result<(), Box<dyn Error>> {
+    let beams = arg(1, 683)?;
+    let rounds = arg(2, 300)?;
+    let mut grid = NdtGrid::new(0.02)?;
+    for i in 0..8u32 {
+        let a = f64::from(i) * 0.8;
+        let pose = Pose2::new(0.3 * a.cos(), 0.2 * a.sin(), a);
+        grid.insert(&common::room_scan(beams, pose, u64::from(i)), pose)?;
+    }
+    let ring: Vec<(Pose2, Vec<[f64; 2]>)> = (0..64u32)
+        .map(|i| {
+            let a = f64::from(i) * std::f64::consts::TAU / 64.0;
+            let pose = Pose2::new(1.2 * a.cos(), 0.8 * a.sin(), a + 1.57);
+            (pose, common::room_scan(beams, pose, 100 + u64::from(i)))
+        })
+        .collect();
+    let options = MatchOptions::default();
+    let (mut t_insert, mut t_match) = (0.0, 0.0);
+    for k in 0..rounds {
+        let (pose, points) = &ring[k % ring.len()];
+        let t = Instant::now();
+        grid.match_scan(points, *pose, &options)?;
+        t_match += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        grid.insert(points, *pose)?;
+        t_insert += t.elapsed().as_secs_f64();
+    }
+    let per = 1e6 / rounds.max(1) as f64;
+    println!(
+        "{rounds} rounds of {beams} beams: insert {:.1} us, match {:.1} us",
+        t_insert * per,
+        t_match * per
+    );
+    Ok(())
+}
