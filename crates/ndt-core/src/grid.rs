@@ -198,22 +198,36 @@ impl NdtGrid {
     pub(crate) fn stage(&self, points: &[[f64; 2]], pose: Pose2) -> Result<StagedScan> {
         check_finite("pose", &pose.to_array())?;
         check_points("points", points)?;
-        let mut staged: Vec<(CellKey, Vector2<f64>)> = Vec::with_capacity(points.len());
         let sin_cos = pose.theta.sin_cos();
-        for (index, p) in points.iter().enumerate() {
-            let w = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
-            // Built only on failure (an eager error is dropped per point).
-            let key =
-                CellKey::of(w, self.inv_cell_size).ok_or_else(|| NdtError::CellIndexOverflow {
-                    what: "points",
-                    index,
-                    x: w.x,
-                    y: w.y,
-                    limit: self.coordinate_limit(),
-                })?;
-            staged.push((key, w));
+        let inv = self.inv_cell_size;
+        // One pass without an exit per point (eq. 2, then the cell): whether
+        // every cell exists is checked once at the end, and only a scan that
+        // fails is searched for its first point beyond the lattice.
+        let mut all = true;
+        let staged: Vec<(CellKey, Vector2<f64>)> = points
+            .iter()
+            .map(|p| {
+                let w = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
+                let (key, ok) = CellKey::of_flagged(w, inv);
+                all &= ok;
+                (key, w)
+            })
+            .collect();
+        if all {
+            return Ok(StagedScan { points: staged });
         }
-        Ok(StagedScan { points: staged })
+        let (index, w) = staged
+            .iter()
+            .enumerate()
+            .find(|(_, (_, w))| !CellKey::of_flagged(*w, inv).1)
+            .map_or((0, Vector2::zeros()), |(i, (_, w))| (i, *w));
+        Err(NdtError::CellIndexOverflow {
+            what: "points",
+            index,
+            x: w.x,
+            y: w.y,
+            limit: self.coordinate_limit(),
+        })
     }
 
     /// Adds a scan staged by [`NdtGrid::stage`] on this grid: eq. (6) into

@@ -21,6 +21,18 @@ fn floor_index(v: f64) -> Option<i32> {
     Some(if f64::from(t) > v { t - 1 } else { t })
 }
 
+/// [`floor_index`] without a branch: the index, and whether it is in range
+/// (the index is meaningless when not), for loops that check a whole batch
+/// at once.
+#[inline(always)]
+fn floor_index_flagged(v: f64) -> (i32, bool) {
+    let lim = f64::from(MAX_INDEX);
+    let ok = v >= 1.0 - lim && v < lim;
+    let t = v as i32; // saturating; exact truncation toward zero when `ok`
+    // Wrapping: a saturated `t` far out of range must not overflow (debug).
+    (t.wrapping_sub(i32::from(f64::from(t) > v)), ok)
+}
+
 /// The integer index `(⌊x / s⌋, ⌊y / s⌋)` of a cell of size `s` (floor division,
 /// so correct for negative coordinates).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -40,6 +52,16 @@ impl CellKey {
             ix: floor_index(p.x * inv_cell_size)?,
             iy: floor_index(p.y * inv_cell_size)?,
         })
+    }
+
+    /// [`CellKey::of`] without a branch: the key and whether it exists (the
+    /// key is meaningless when it does not), for loops over many points
+    /// that check them all at once.
+    #[inline(always)]
+    pub fn of_flagged(p: Vector2<f64>, inv_cell_size: f64) -> (CellKey, bool) {
+        let (ix, okx) = floor_index_flagged(p.x * inv_cell_size);
+        let (iy, oky) = floor_index_flagged(p.y * inv_cell_size);
+        (CellKey { ix, iy }, okx & oky)
     }
 
     /// Centre of the cell \[m\].
@@ -150,6 +172,9 @@ mod tests {
         }
         for v in cases {
             assert_eq!(floor_index(v), by_floor(v), "v = {v:e}");
+            // The branch-free form: the same index, flagged where it exists.
+            let (t, ok) = floor_index_flagged(v);
+            assert_eq!(ok.then_some(t), floor_index(v), "flagged, v = {v:e}");
         }
     }
 }

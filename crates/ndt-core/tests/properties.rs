@@ -195,6 +195,32 @@ fn error_is_input(e: &NdtError) -> bool {
     )
 }
 
+/// An insert with points beyond the lattice names the first of them, with
+/// its map coordinates, and changes nothing (the scan is staged in one pass
+/// and checked at its end).
+#[test]
+fn an_insert_beyond_the_lattice_names_its_first_such_point() {
+    let mut grid = NdtGrid::new(0.02).unwrap_or_else(|e| panic!("{e}"));
+    let pose = Pose2::new(1.0, -2.0, 0.3);
+    let mut pts: Vec<[f64; 2]> = (0..40).map(|i| [0.1 * f64::from(i), 0.5]).collect();
+    grid.insert(&pts, pose).unwrap_or_else(|e| panic!("{e}"));
+    let before = grid.cell_states();
+    pts[17] = [3e7, 0.0];
+    pts[29] = [-5e7, 1.0];
+    let w = pose.transform(Vector2::new(3e7, 0.0));
+    match grid.insert(&pts, pose) {
+        Err(NdtError::CellIndexOverflow {
+            what: "points",
+            index: 17,
+            x,
+            y,
+            ..
+        }) => assert_eq!((x, y), (w.x, w.y)),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(before, grid.cell_states());
+}
+
 proptest! {
     #![proptest_config(config())]
 
