@@ -1012,7 +1012,13 @@ def intel_corrected() -> tuple[list[F64], F64]:
 def map_sweep(args: argparse.Namespace) -> list[dict[str, Any]]:
     """Match time against map size: the last ``tests`` Intel scans matched against maps of
     the ``k`` scans before each, then against a map of the 30 scans before plus ``c`` far
-    copies (1 km apart) of the whole log's map (only the size grows)."""
+    copies (1 km apart) of the whole log's map (only the size grows).
+
+    Within each sweep the sizes are interleaved: every test scan's maps of all sizes are
+    built first, then each start is matched on each of them in an order turned from start
+    to start, so a change in the machine's speed during the sweep (this project's VMs
+    drift by tens of per cent within minutes) falls on every size alike instead of
+    looking like a trend in map size."""
     pts, poses = intel_corrected()
     n = len(pts)
     tests = list(range(n - args.sweep_tests, n))
@@ -1020,27 +1026,36 @@ def map_sweep(args: argparse.Namespace) -> list[dict[str, Any]]:
     deltas = {t: convergence.starts(rng, args.starts, 0.05, 2.0) for t in tests}
     rows: list[dict[str, Any]] = []
 
-    def measure(label: str, kind: str, build: Callable[[int], ndtgrid.NdtGrid]) -> None:
-        times, cells, iters = [], [], []
-        for t in tests:
-            grid = build(t)
-            grid.match(pts[t], poses[t])  # build the distributions, warm up
-            cells.append(len(grid))
+    def measure(
+        kind: str, labels: list[str], builds: list[Callable[[int], ndtgrid.NdtGrid]]
+    ) -> None:
+        times: list[list[float]] = [[] for _ in builds]
+        cells: list[list[int]] = [[] for _ in builds]
+        iters: list[list[int]] = [[] for _ in builds]
+        for t in progress(tests, f"sweep: {kind} maps, test scans"):
+            grids = [build(t) for build in builds]
+            for g, c in zip(grids, cells):
+                g.match(pts[t], poses[t])  # build the distributions, warm up
+                c.append(len(g))
             with no_gc():
-                for d in deltas[t]:
-                    t0 = time.perf_counter()
-                    m = grid.match(pts[t], poses[t] + d)
-                    times.append(time.perf_counter() - t0)
-                    iters.append(m.iterations)
-        rows.append(
-            {
-                "label": label,
-                "kind": kind,
-                "cells": float(np.mean(cells)),
-                "median": float(np.median(times)),
-                "iterations": float(np.median(iters)),
-            }
-        )
+                for j, d in enumerate(deltas[t]):
+                    for k in range(len(grids)):
+                        i = (k + j + t) % len(grids)
+                        t0 = time.perf_counter()
+                        m = grids[i].match(pts[t], poses[t] + d)
+                        times[i].append(time.perf_counter() - t0)
+                        iters[i].append(m.iterations)
+            del grids
+        for i, label in enumerate(labels):
+            rows.append(
+                {
+                    "label": label,
+                    "kind": kind,
+                    "cells": float(np.mean(cells[i])),
+                    "median": float(np.median(times[i])),
+                    "iterations": float(np.median(iters[i])),
+                }
+            )
 
     def recent(k: int) -> Callable[[int], ndtgrid.NdtGrid]:
         def build(t: int) -> ndtgrid.NdtGrid:
@@ -1051,8 +1066,8 @@ def map_sweep(args: argparse.Namespace) -> list[dict[str, Any]]:
 
         return build
 
-    for k in progress(args.sweep_scans, "sweep: map of the last k scans"):
-        measure(f"last {k} scans", "recent", recent(min(k, n - args.sweep_tests)))
+    scans = [min(k, n - args.sweep_tests) for k in args.sweep_scans]
+    measure("recent", [f"last {k} scans" for k in args.sweep_scans], [recent(k) for k in scans])
 
     def padded(copies: int) -> Callable[[int], ndtgrid.NdtGrid]:
         far = ndtgrid.NdtGrid(CELL)  # built once per size, copied per test scan
@@ -1069,9 +1084,11 @@ def map_sweep(args: argparse.Namespace) -> list[dict[str, Any]]:
 
         return build
 
-    for c in progress(args.sweep_copies, "sweep: far copies"):
-        label = f"last 30 scans + {c} far copies of the log" if c else "last 30 scans"
-        measure(label, "padded", padded(c))
+    labels = [
+        f"last 30 scans + {c} far copies of the log" if c else "last 30 scans"
+        for c in args.sweep_copies
+    ]
+    measure("padded", labels, [padded(c) for c in progress(args.sweep_copies, "sweep: far maps")])
     return rows
 
 
@@ -1111,7 +1128,9 @@ def section_sweeps(args: argparse.Namespace) -> dict[str, Any]:
             "matched against 2 cm maps of the k scans before each (the area grows with k), "
             "then against the 30 scans before each plus far copies of the whole log's map "
             f"({FAR:g} m apart: only the map's size grows); {args.starts} local starts per "
-            "scan; default `match()`.\n",
+            "scan; default `match()`. Within each sweep every start is matched on every "
+            "size in turn (the order turned from start to start), so the machine's drift "
+            "falls on all sizes alike.\n",
             "| map | occupied cells | median [ms] | median iterations |",
             "|---|---:|---:|---:|",
         ]
