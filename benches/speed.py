@@ -17,11 +17,14 @@ as a Markdown table to stdout as soon as it is measured (progress goes to stderr
    (each run in a fresh child process, which also reports the run's peak resident memory;
    the default loop three times, judged on the median run) against the
    small_gicp voxel-map odometry of ``benches/datasets.py`` and KISS-ICP (when
-   ``kiss-icp`` is installed), with the relation error of each.
+   ``kiss-icp`` is installed), with the relation error of each. KISS-ICP at its default
+   voxel, the fastest peer, runs right after each of our runs (with either prior) and is
+   judged on its median run too, so the machine's drift falls on both sides alike.
 4. **Sweeps**: match time against the number of scan points (simulated scans, 100-4000
    beams, one map) and against the map's size (real Intel maps of 1-880 scans, then far
-   away copies of the whole map); linear fits; a plot in ``docs/img/speed_sweeps.png``
-   when matplotlib is installed.
+   away copies of the whole map; within each, every start is matched on every size in
+   turn); linear fits; a plot in ``docs/img/speed_sweeps.png`` when matplotlib is
+   installed.
 5. **Threads**: matches per second of two Python threads matching different scans
    against one grid, against one thread.
 6. **Memory**: bytes per occupied fine cell (RSS growth of a fresh child process divided by
