@@ -28,8 +28,9 @@ fn floor_index(v: f64) -> Option<i32> {
 fn floor_index_flagged(v: f64) -> (i32, bool) {
     let lim = f64::from(MAX_INDEX);
     let ok = v >= 1.0 - lim && v < lim;
-    let t = v as i32; // saturating; exact truncation toward zero when `ok`
-    // Wrapping: a saturated `t` far out of range must not overflow (debug).
+    // Saturating, and exact truncation toward zero when `ok`; the wrapping
+    // subtraction keeps a saturated `t` far out of range from overflowing.
+    let t = v as i32;
     (t.wrapping_sub(i32::from(f64::from(t) > v)), ok)
 }
 
