@@ -85,13 +85,25 @@ impl<'a> ScanPairs<'a> {
             valid: vec![0; n],
             same: vec![0; n],
         };
-        pairs.bind(points, weights);
+        // Fresh chunks hold zeros, pairs included: only the points are set.
+        pairs.set_points(points, weights);
         pairs
     }
 
     /// The same pairs' storage for other `points` (at most as many as at
     /// [`ScanPairs::new`]; any more are left out), with nothing paired.
     fn bind(&mut self, points: &'a [[f64; 2]], weights: Option<&'a [f64]>) {
+        self.set_points(points, weights);
+        for ch in &mut self.chunks {
+            for l in 0..LANES {
+                ch.clear_pair(l);
+            }
+        }
+    }
+
+    /// The points of the chunks (padding lanes at the origin; with no pair
+    /// they add exact zeros), leaving the pairs' columns as they are.
+    fn set_points(&mut self, points: &'a [[f64; 2]], weights: Option<&'a [f64]>) {
         let n = points.len().div_ceil(LANES).min(self.keys.len());
         self.points = points
             .get(..(n * LANES).min(points.len()))
@@ -104,8 +116,6 @@ impl<'a> ScanPairs<'a> {
                 let p = self.points.get(c * LANES + l).copied().unwrap_or([0.0; 2]);
                 ch.x[l] = p[0];
                 ch.y[l] = p[1];
-                // Lanes past the last point (padding) add exact zeros.
-                ch.clear_pair(l);
             }
         }
     }
