@@ -216,6 +216,8 @@ impl NdtGrid {
         if all {
             return Ok(StagedScan { points: staged });
         }
+        // Some point failed the same test, so it is found (the fallback is
+        // never taken).
         let (index, w) = staged
             .iter()
             .enumerate()

@@ -59,7 +59,7 @@ impl CellKey {
     /// key is meaningless when it does not), for loops over many points
     /// that check them all at once.
     #[inline(always)]
-    pub fn of_flagged(p: Vector2<f64>, inv_cell_size: f64) -> (CellKey, bool) {
+    pub(crate) fn of_flagged(p: Vector2<f64>, inv_cell_size: f64) -> (CellKey, bool) {
         let (ix, okx) = floor_index_flagged(p.x * inv_cell_size);
         let (iy, oky) = floor_index_flagged(p.y * inv_cell_size);
         (CellKey { ix, iy }, okx & oky)
