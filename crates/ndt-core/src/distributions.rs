@@ -12,7 +12,7 @@ use crate::gather;
 use crate::key::CellKey;
 use crate::moments::{self, GaussBatch, StatsBatch};
 use crate::scratch::{KeyScratch, KeySet};
-use crate::shape::Shape;
+use crate::shape::{AncestorShape, Shape, ShapeMemo};
 use crate::shaped::{Ancestor, ShapedCursor, ShapedStore};
 use crate::table::{CellTable, Cursor};
 
@@ -141,12 +141,15 @@ impl Distributions {
     /// whose shape changed only in value is written once for all the cells
     /// under it ([`crate::shaped`]); one that gained or lost its shape sets
     /// every cell under it again.
+    /// `shapes` keeps the ancestors' shapes for the other levels updated
+    /// after the same change (see [`ShapeMemo`]).
     pub fn update(
         &mut self,
         cells: &CellTable<CellStats>,
         cell_size: f64,
         touched: &[CellKey],
         shape: Option<Shape<'_>>,
+        shapes: &mut ShapeMemo,
     ) {
         let options = self.options;
         let seen = self.seen.take();
@@ -156,7 +159,15 @@ impl Distributions {
                     minority: &mut self.minority,
                     seen,
                 };
-                update_shaped(store, search, cells, cell_size, options, touched, s);
+                update_shaped(
+                    store,
+                    search,
+                    cells,
+                    cell_size,
+                    options,
+                    touched,
+                    (s, shapes),
+                );
             }
             (Store::Own(map), _) => {
                 update_own(map, seen, cells, cell_size, options, touched);
@@ -421,7 +432,7 @@ fn update_shaped(
     cell_size: f64,
     options: DistOptions,
     touched: &[CellKey],
-    s: Shape<'_>,
+    (s, shapes): (Shape<'_>, &mut ShapeMemo),
 ) {
     let depth = s.depth();
     let ancestor_of = |k: CellKey| crate::pyramid::coarse_key(k, depth);
@@ -429,13 +440,16 @@ fn update_shaped(
     // under one ancestor): those whose kind changed set all their cells again.
     // (The search's scratch set, emptied again before the search.)
     let seen = &mut *search.seen;
+    let mut kept = shapes.reader(s, options.sigma_floor, options.expansion);
     let mut changed = FxHashSet::default();
     let mut last = None;
     for &key in touched {
         let at = ancestor_of(key);
         if last != Some(at) {
             last = Some(at);
-            if seen.insert(at) && store.set_ancestor(at, shape_of_ancestor(s, at, options)) {
+            if seen.insert(at)
+                && store.set_ancestor(at, kept.next(at, || shape_of_ancestor(s, at, options)))
+            {
                 changed.insert(at);
             }
         }
@@ -562,7 +576,7 @@ fn set_shared(store: &mut ShapedStore, cell_size: f64, key: CellKey, own: &CellS
 /// ([`Gaussian::shape_of`]): `None` when the ancestor has fewer than
 /// [`MIN_POINTS`] points (its cells keep their own distributions),
 /// `Some(None)` when it has no distribution.
-fn shape_of_ancestor(s: Shape<'_>, at: CellKey, options: DistOptions) -> Option<Option<Gaussian>> {
+fn shape_of_ancestor(s: Shape<'_>, at: CellKey, options: DistOptions) -> AncestorShape {
     s.cells()
         .get(at)
         .filter(|a| a.count >= MIN_POINTS)

@@ -11,7 +11,7 @@ use crate::error::{check_finite, NdtError, Result};
 use crate::key::{CellKey, KeyBounds, MAX_INDEX};
 use crate::pyramid::{Level, Pyramid, MAX_LEVELS};
 use crate::se2::Pose2;
-use crate::shape::Shape;
+use crate::shape::{Shape, ShapeMemo};
 use crate::table::CellTable;
 
 mod edit;
@@ -237,14 +237,7 @@ impl NdtGrid {
     /// cells. Returns the touched finest-level keys (see [`NdtGrid::insert`]).
     pub(crate) fn insert_staged(&mut self, staged: StagedScan) -> Vec<CellKey> {
         let touched = self.pyramid.add(&staged.points);
-        let prepared = self.prepared.get_mut().unwrap_or_else(|e| e.into_inner());
-        for dist in prepared.iter_mut() {
-            let l = dist.level();
-            if let (Some(level), Some(keys)) = (self.pyramid.level(l), touched.get(l)) {
-                let shape = shape_at(&self.pyramid, l, dist.shape_depth());
-                Arc::make_mut(dist).update(level.cells(), level.cell_size(), keys, shape);
-            }
-        }
+        self.update_prepared(&touched);
         touched.into_iter().next().unwrap_or_default()
     }
 
@@ -263,15 +256,29 @@ impl NdtGrid {
         if removed == 0 {
             return 0;
         }
+        self.update_prepared(&touched);
+        removed
+    }
+
+    /// Brings the prepared distributions up to date after the pyramid
+    /// changed the cells `touched` (keys per level), each touched ancestor's
+    /// shape computed once for all the levels that take it.
+    fn update_prepared(&mut self, touched: &[Vec<CellKey>]) {
         let prepared = self.prepared.get_mut().unwrap_or_else(|e| e.into_inner());
+        let mut shapes = ShapeMemo::default();
         for dist in prepared.iter_mut() {
             let l = dist.level();
             if let (Some(level), Some(keys)) = (self.pyramid.level(l), touched.get(l)) {
                 let shape = shape_at(&self.pyramid, l, dist.shape_depth());
-                Arc::make_mut(dist).update(level.cells(), level.cell_size(), keys, shape);
+                Arc::make_mut(dist).update(
+                    level.cells(),
+                    level.cell_size(),
+                    keys,
+                    shape,
+                    &mut shapes,
+                );
             }
         }
-        removed
     }
 
     /// A rectangle of cell indices holding every occupied cell (possibly more:

@@ -17,7 +17,7 @@
 
 use rustc_hash::FxHashSet;
 
-use crate::cell::CellStats;
+use crate::cell::{CellStats, Gaussian};
 use crate::key::CellKey;
 use crate::pyramid::Level;
 use crate::table::CellTable;
@@ -94,5 +94,136 @@ impl<'a> Shape<'a> {
             }
         }
         out
+    }
+}
+
+/// What an ancestor gives as a shape ([`Gaussian::shape_of`] of its sums:
+/// `None` below [`crate::cell::MIN_POINTS`] points, `Some(None)` without a
+/// finite distribution).
+pub type AncestorShape = Option<Option<Gaussian>>;
+
+/// The shapes of the ancestors one insert or removal touched, kept while the
+/// prepared distributions are brought up to date: every level finer than the
+/// shape cell takes its shapes from the same shape level, so without it each
+/// touched ancestor's shape would be computed once per level.
+///
+/// A level's update meets the touched ancestors in the order their keys
+/// first occur among its own touched cells, which for every level is the
+/// order of the shape level's own touched keys (each level's are its
+/// children's parents in order of first occurrence). So the first level to
+/// ask computes and keeps the shapes in that order, and the others read them
+/// back in step; an ancestor met out of step is computed afresh (never by
+/// these updates, but the result does not depend on it).
+#[derive(Debug, Default)]
+pub struct ShapeMemo {
+    /// Per shape level and options: the shapes in the order computed.
+    runs: Vec<(RunKey, Vec<(CellKey, AncestorShape)>)>,
+}
+
+/// A shape level and the options its shapes depend on: its cell size, the σ
+/// floor and `k`, as bits.
+type RunKey = (u64, u64, u64);
+
+/// One level's reading of a [`ShapeMemo`] (see there).
+#[derive(Debug)]
+pub struct ShapeReader<'m> {
+    /// The kept shapes (`None` would only compute; never the case).
+    shapes: Option<&'m mut Vec<(CellKey, AncestorShape)>>,
+    next: usize,
+}
+
+impl ShapeMemo {
+    /// A reader of the shapes of `shape`'s ancestors under σ floor
+    /// `sigma_floor` and expansion `k` (the options they depend on).
+    pub fn reader(&mut self, shape: Shape<'_>, sigma_floor: f64, k: f64) -> ShapeReader<'_> {
+        let key = (
+            shape.top.cell_size().to_bits(),
+            sigma_floor.to_bits(),
+            k.to_bits(),
+        );
+        let run = match self.runs.iter().position(|(k, _)| *k == key) {
+            Some(i) => self.runs.get_mut(i),
+            None => {
+                self.runs.push((key, Vec::new()));
+                self.runs.last_mut()
+            }
+        };
+        ShapeReader {
+            shapes: run.map(|(_, shapes)| shapes),
+            next: 0,
+        }
+    }
+}
+
+impl ShapeReader<'_> {
+    /// The shape of the next ancestor met, `at`: the one kept when it is the
+    /// next in step, else `compute`'s (kept when nothing is kept at this
+    /// position yet).
+    pub fn next(&mut self, at: CellKey, compute: impl FnOnce() -> AncestorShape) -> AncestorShape {
+        let i = self.next;
+        self.next += 1;
+        let Some(shapes) = self.shapes.as_deref_mut() else {
+            return compute();
+        };
+        match shapes.get(i) {
+            Some((k, shape)) if *k == at => *shape,
+            Some(_) => compute(),
+            None => {
+                let shape = compute();
+                if i == shapes.len() {
+                    shapes.push((at, shape));
+                }
+                shape
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::pyramid::Pyramid;
+    use nalgebra::{Matrix2, Vector2};
+    use std::cell::Cell;
+
+    fn shape(v: f64) -> AncestorShape {
+        Some(Some(Gaussian {
+            mean: Vector2::new(v, 0.0),
+            inverse: Matrix2::identity() * v,
+            normal: Vector2::new(0.0, 1.0),
+        }))
+    }
+
+    #[test]
+    fn a_memo_gives_kept_shapes_in_step_and_computes_the_rest() {
+        let pyramid = Pyramid::new(0.02, 3);
+        let s = pyramid.levels(0..=2).and_then(Shape::new).unwrap();
+        let key = |ix| CellKey { ix, iy: 0 };
+        let calls = Cell::new(0);
+        let compute = |v: f64| {
+            calls.set(calls.get() + 1);
+            shape(v)
+        };
+        let mut memo = ShapeMemo::default();
+        // The first level computes and keeps, in the order met.
+        let mut first = memo.reader(s, 0.02, 10.0);
+        assert_eq!(first.next(key(1), || compute(1.0)), shape(1.0));
+        assert_eq!(first.next(key(2), || compute(2.0)), shape(2.0));
+        assert_eq!(calls.get(), 2);
+        // The next reads them back in step; out of step it computes (and
+        // does not overwrite what is kept).
+        let mut second = memo.reader(s, 0.02, 10.0);
+        assert_eq!(second.next(key(1), || compute(9.0)), shape(1.0));
+        assert_eq!(second.next(key(3), || compute(3.0)), shape(3.0));
+        assert_eq!(calls.get(), 3);
+        let mut third = memo.reader(s, 0.02, 10.0);
+        assert_eq!(third.next(key(1), || compute(9.0)), shape(1.0));
+        assert_eq!(third.next(key(2), || compute(9.0)), shape(2.0));
+        assert_eq!(calls.get(), 3);
+        // Other options are other shapes.
+        let mut other = memo.reader(s, 0.02, 5.0);
+        assert_eq!(other.next(key(1), || compute(5.0)), shape(5.0));
+        assert_eq!(calls.get(), 4);
     }
 }
