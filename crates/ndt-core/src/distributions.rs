@@ -12,7 +12,7 @@ use crate::gather;
 use crate::key::CellKey;
 use crate::moments::{self, GaussBatch, StatsBatch};
 use crate::scratch::{KeyScratch, KeySet};
-use crate::shape::{AncestorShape, Shape, ShapeMemo};
+use crate::shape::{AncestorShape, Shape, ShapeMemo, ShapeReader};
 use crate::shaped::{Ancestor, ShapedCursor, ShapedStore};
 use crate::table::{CellTable, Cursor};
 
@@ -159,15 +159,8 @@ impl Distributions {
                     minority: &mut self.minority,
                     seen,
                 };
-                update_shaped(
-                    store,
-                    search,
-                    cells,
-                    cell_size,
-                    options,
-                    touched,
-                    (s, shapes),
-                );
+                let shapes = shapes.reader(s, options.sigma_floor, options.expansion);
+                update_shaped(store, search, cells, cell_size, options, touched, shapes);
             }
             (Store::Own(map), _) => {
                 update_own(map, seen, cells, cell_size, options, touched);
@@ -432,15 +425,15 @@ fn update_shaped(
     cell_size: f64,
     options: DistOptions,
     touched: &[CellKey],
-    (s, shapes): (Shape<'_>, &mut ShapeMemo),
+    mut shapes: ShapeReader<'_, '_>,
 ) {
+    let s = shapes.shape();
     let depth = s.depth();
     let ancestor_of = |k: CellKey| crate::pyramid::coarse_key(k, depth);
     // The touched cells' ancestors, each once (a scan's cells come in runs
     // under one ancestor): those whose kind changed set all their cells again.
     // (The search's scratch set, emptied again before the search.)
     let seen = &mut *search.seen;
-    let mut kept = shapes.reader(s, options.sigma_floor, options.expansion);
     let mut changed = FxHashSet::default();
     let mut last = None;
     for &key in touched {
@@ -448,7 +441,7 @@ fn update_shaped(
         if last != Some(at) {
             last = Some(at);
             if seen.insert(at)
-                && store.set_ancestor(at, kept.next(at, || shape_of_ancestor(s, at, options)))
+                && store.set_ancestor(at, shapes.next(at, || shape_of_ancestor(s, at, options)))
             {
                 changed.insert(at);
             }
@@ -643,7 +636,6 @@ struct OwnBatch<F: FnMut(CellKey, Option<Gaussian>)> {
     cell_size: f64,
     options: DistOptions,
     keys: [CellKey; moments::BATCH],
-    present: [bool; moments::BATCH],
     len: usize,
     stats: StatsBatch,
     out: GaussBatch,
@@ -656,7 +648,6 @@ impl<F: FnMut(CellKey, Option<Gaussian>)> OwnBatch<F> {
             cell_size,
             options,
             keys: [CellKey { ix: 0, iy: 0 }; moments::BATCH],
-            present: [false; moments::BATCH],
             len: 0,
             stats: StatsBatch::default(),
             out: GaussBatch::default(),
@@ -665,7 +656,7 @@ impl<F: FnMut(CellKey, Option<Gaussian>)> OwnBatch<F> {
     }
 
     /// Cell `key`, whose distribution comes from the sums `s` about its
-    /// centre (`None`: it has no points).
+    /// centre (`None`: it has no points, so as empty sums it gets none).
     #[inline]
     fn push(&mut self, key: CellKey, s: Option<CellStats>) {
         if self.len == moments::BATCH {
@@ -674,9 +665,8 @@ impl<F: FnMut(CellKey, Option<Gaussian>)> OwnBatch<F> {
         let l = self.len;
         self.stats
             .set(l, &s.unwrap_or_default(), key.center(self.cell_size));
-        if let (Some(k), Some(p)) = (self.keys.get_mut(l), self.present.get_mut(l)) {
+        if let Some(k) = self.keys.get_mut(l) {
             *k = key;
-            *p = s.is_some();
         }
         self.len += 1;
     }
@@ -684,14 +674,8 @@ impl<F: FnMut(CellKey, Option<Gaussian>)> OwnBatch<F> {
     fn flush(&mut self) {
         let (floor, k) = (self.options.sigma_floor, self.options.expansion);
         moments::gaussians(&self.stats, floor, k, &mut self.out);
-        for (l, (&key, &p)) in self
-            .keys
-            .iter()
-            .zip(&self.present)
-            .enumerate()
-            .take(self.len)
-        {
-            (self.emit)(key, self.out.get(l).filter(|_| p));
+        for (l, &key) in self.keys.iter().enumerate().take(self.len) {
+            (self.emit)(key, self.out.get(l));
         }
         self.len = 0;
     }

@@ -124,9 +124,11 @@ pub struct ShapeMemo {
 /// floor and `k`, as bits.
 type RunKey = (u64, u64, u64);
 
-/// One level's reading of a [`ShapeMemo`] (see there).
+/// One level's reading of a [`ShapeMemo`] (see there), with the shape level
+/// it reads for.
 #[derive(Debug)]
-pub struct ShapeReader<'m> {
+pub struct ShapeReader<'m, 's> {
+    shape: Shape<'s>,
     /// The kept shapes (`None` would only compute; never the case).
     shapes: Option<&'m mut Vec<(CellKey, AncestorShape)>>,
     next: usize,
@@ -135,7 +137,12 @@ pub struct ShapeReader<'m> {
 impl ShapeMemo {
     /// A reader of the shapes of `shape`'s ancestors under σ floor
     /// `sigma_floor` and expansion `k` (the options they depend on).
-    pub fn reader(&mut self, shape: Shape<'_>, sigma_floor: f64, k: f64) -> ShapeReader<'_> {
+    pub fn reader<'s>(
+        &mut self,
+        shape: Shape<'s>,
+        sigma_floor: f64,
+        k: f64,
+    ) -> ShapeReader<'_, 's> {
         let key = (
             shape.top.cell_size().to_bits(),
             sigma_floor.to_bits(),
@@ -149,13 +156,19 @@ impl ShapeMemo {
             }
         };
         ShapeReader {
+            shape,
             shapes: run.map(|(_, shapes)| shapes),
             next: 0,
         }
     }
 }
 
-impl ShapeReader<'_> {
+impl<'s> ShapeReader<'_, 's> {
+    /// The shape level read for.
+    pub fn shape(&self) -> Shape<'s> {
+        self.shape
+    }
+
     /// The shape of the next ancestor met, `at`: the one kept when it is the
     /// next in step, else `compute`'s (kept when nothing is kept at this
     /// position yet).
