@@ -11,6 +11,7 @@
 use rustc_hash::FxHashMap;
 
 use crate::key::CellKey;
+use crate::parity::ParityMemo;
 
 /// log2 of a block's side \[cells\].
 const BLOCK_BITS: i32 = 3;
@@ -98,7 +99,7 @@ impl CellMask {
     pub fn reader(&self) -> CellMaskReader<'_> {
         CellMaskReader {
             mask: self,
-            last: [None; 4],
+            last: ParityMemo::new(0),
         }
     }
 
@@ -119,27 +120,24 @@ impl CellMask {
 #[derive(Debug)]
 pub struct CellMaskReader<'a> {
     mask: &'a CellMask,
-    last: [Option<((i32, i32), u64)>; 4],
+    last: ParityMemo<u64>,
 }
 
 impl CellMaskReader<'_> {
     /// The word of `block` (0 when the mask has none).
     #[inline(always)]
     fn word(&mut self, block: (i32, i32)) -> u64 {
-        let parity = crate::table::parity(block);
-        match self.last.get(parity).copied().flatten() {
-            Some((b, w)) if b == block => w,
-            _ => self.find(block, parity),
+        match self.last.get(block) {
+            Some(w) => w,
+            None => self.find(block),
         }
     }
 
     /// The hashed look-up of a word not remembered.
     #[inline(never)]
-    fn find(&mut self, block: (i32, i32), parity: usize) -> u64 {
+    fn find(&mut self, block: (i32, i32)) -> u64 {
         let w = self.mask.blocks.get(&block).copied().unwrap_or(0);
-        if let Some(r) = self.last.get_mut(parity) {
-            *r = Some((block, w));
-        }
+        self.last.set(block, w);
         w
     }
 

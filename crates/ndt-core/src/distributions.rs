@@ -672,6 +672,9 @@ impl<F: FnMut(CellKey, Option<Gaussian>)> OwnBatch<F> {
     }
 
     fn flush(&mut self) {
+        if self.len == 0 {
+            return;
+        }
         let (floor, k) = (self.options.sigma_floor, self.options.expansion);
         moments::gaussians(&self.stats, floor, k, &mut self.out);
         for (l, &key) in self.keys.iter().enumerate().take(self.len) {

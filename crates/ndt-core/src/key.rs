@@ -6,27 +6,15 @@ use nalgebra::Vector2;
 /// and coarse levels never overflow `i32`.
 pub const MAX_INDEX: i32 = 1 << 30;
 
-/// `⌊v⌋` as an index when `|⌊v⌋| < MAX_INDEX` (`None` otherwise and for
-/// NaN). The same value as `v.floor() as i32`, without the libm call that
-/// CPUs without SSE4.1's `roundsd` (the default x86-64 target) make for
-/// `floor`: this is on the matcher's per-point path.
-#[inline]
-fn floor_index(v: f64) -> Option<i32> {
+/// `⌊v⌋` as an index, and whether `|⌊v⌋| < MAX_INDEX` (false for NaN; the
+/// index is meaningless then). The same value as `v.floor() as i32`, without
+/// the libm call that CPUs without SSE4.1's `roundsd` (the default x86-64
+/// target) make for `floor`, and without a branch, so loops over many points
+/// can check them all at once.
+#[inline(always)]
+fn floor_index(v: f64) -> (i32, bool) {
     let lim = f64::from(MAX_INDEX);
     // ⌊v⌋ > −lim ⇔ v ≥ 1 − lim; ⌊v⌋ < lim ⇔ v < lim; both false for NaN.
-    if !(v >= 1.0 - lim && v < lim) {
-        return None;
-    }
-    let t = v as i32; // truncation toward zero, exact in this range
-    Some(if f64::from(t) > v { t - 1 } else { t })
-}
-
-/// [`floor_index`] without a branch: the index, and whether it is in range
-/// (the index is meaningless when not), for loops that check a whole batch
-/// at once.
-#[inline(always)]
-fn floor_index_flagged(v: f64) -> (i32, bool) {
-    let lim = f64::from(MAX_INDEX);
     let ok = v >= 1.0 - lim && v < lim;
     // Saturating, and exact truncation toward zero when `ok`; the wrapping
     // subtraction keeps a saturated `t` far out of range from overflowing.
@@ -49,10 +37,8 @@ impl CellKey {
     /// exceed ±[`MAX_INDEX`] (or `p` is not finite).
     #[inline]
     pub fn of(p: Vector2<f64>, inv_cell_size: f64) -> Option<CellKey> {
-        Some(CellKey {
-            ix: floor_index(p.x * inv_cell_size)?,
-            iy: floor_index(p.y * inv_cell_size)?,
-        })
+        let (key, ok) = Self::of_flagged(p, inv_cell_size);
+        ok.then_some(key)
     }
 
     /// [`CellKey::of`] without a branch: the key and whether it exists (the
@@ -60,8 +46,8 @@ impl CellKey {
     /// that check them all at once.
     #[inline(always)]
     pub(crate) fn of_flagged(p: Vector2<f64>, inv_cell_size: f64) -> (CellKey, bool) {
-        let (ix, okx) = floor_index_flagged(p.x * inv_cell_size);
-        let (iy, oky) = floor_index_flagged(p.y * inv_cell_size);
+        let (ix, okx) = floor_index(p.x * inv_cell_size);
+        let (iy, oky) = floor_index(p.y * inv_cell_size);
         (CellKey { ix, iy }, okx & oky)
     }
 
@@ -172,10 +158,11 @@ mod tests {
             cases.extend([n, n - f64::EPSILON * n.abs(), n + f64::EPSILON * n.abs()]);
         }
         for v in cases {
-            assert_eq!(floor_index(v), by_floor(v), "v = {v:e}");
-            // The branch-free form: the same index, flagged where it exists.
-            let (t, ok) = floor_index_flagged(v);
-            assert_eq!(ok.then_some(t), floor_index(v), "flagged, v = {v:e}");
+            let (t, ok) = floor_index(v);
+            assert_eq!(ok.then_some(t), by_floor(v), "v = {v:e}");
+            // A key is the index of both coordinates, where both exist.
+            let key = CellKey::of(Vector2::new(v, 0.5), 1.0);
+            assert_eq!(key.map(|k| k.ix), by_floor(v), "key, v = {v:e}");
         }
     }
 }

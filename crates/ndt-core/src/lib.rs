@@ -40,6 +40,7 @@ pub mod moments;
 pub mod neighbor;
 pub mod odometry;
 pub mod pairs;
+mod parity;
 pub mod persist;
 pub mod pyramid;
 pub mod quadratic;

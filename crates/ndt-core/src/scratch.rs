@@ -12,6 +12,7 @@
 use rustc_hash::FxHashMap;
 
 use crate::key::CellKey;
+use crate::parity::ParityMemo;
 
 /// log2 of a block's side \[cells\].
 const BLOCK_BITS: i32 = 3;
@@ -26,7 +27,7 @@ pub(crate) struct KeySet {
     /// The last block asked about of each parity of its index (any 2 × 2
     /// blocks, around a cell's neighbours, have one of each), and its
     /// position.
-    last: [Option<((i32, i32), u32)>; 4],
+    last: ParityMemo<u32>,
 }
 
 impl KeySet {
@@ -35,10 +36,9 @@ impl KeySet {
     pub(crate) fn insert(&mut self, key: CellKey) -> bool {
         let block = (key.ix >> BLOCK_BITS, key.iy >> BLOCK_BITS);
         let bit = 1u64 << (((key.iy & MASK) << BLOCK_BITS) | (key.ix & MASK));
-        let parity = crate::table::parity(block);
-        let at = match self.last.get(parity).copied().flatten() {
-            Some((b, at)) if b == block => at,
-            _ => self.block(block, parity),
+        let at = match self.last.get(block) {
+            Some(at) => at,
+            None => self.block(block),
         };
         match self.words.get_mut(at as usize) {
             Some(word) => {
@@ -52,15 +52,13 @@ impl KeySet {
 
     /// The position of `block`'s word, a new empty one when it has none.
     #[inline(never)]
-    fn block(&mut self, block: (i32, i32), parity: usize) -> u32 {
+    fn block(&mut self, block: (i32, i32)) -> u32 {
         let next = self.words.len() as u32;
         let at = *self.index.entry(block).or_insert(next);
         if at == next {
             self.words.push(0);
         }
-        if let Some(r) = self.last.get_mut(parity) {
-            *r = Some((block, at));
-        }
+        self.last.set(block, at);
         at
     }
 
@@ -68,7 +66,7 @@ impl KeySet {
     pub(crate) fn clear(&mut self) {
         self.index.clear();
         self.words.clear();
-        self.last = [None; 4];
+        self.last.clear();
     }
 }
 
@@ -92,7 +90,7 @@ impl Clone for KeyScratch {
         Self(KeySet {
             index: FxHashMap::with_capacity_and_hasher(self.0.index.capacity(), Default::default()),
             words: Vec::with_capacity(self.0.words.capacity()),
-            last: [None; 4],
+            last: ParityMemo::new(0),
         })
     }
 }

@@ -14,6 +14,7 @@
 use rustc_hash::FxHashMap;
 
 use crate::key::CellKey;
+use crate::parity::ParityMemo;
 
 /// log2 of the tile side \[cells\].
 const TILE_BITS: i32 = 3;
@@ -62,11 +63,10 @@ pub struct CellTable<T> {
     /// alignment (the matcher's distributions do).
     values: Vec<T>,
     keys: Vec<CellKey>,
-    /// The tile of the last insert of each parity of the tile index (packed,
-    /// [`NEVER`]: none), so runs of inserts in one tile, and inserts around
-    /// one cell across tile borders, skip the hash.
-    insert_keys: [u64; 4],
-    insert_tiles: [u32; 4],
+    /// The tile of the last insert of each parity of the tile index, so runs
+    /// of inserts in one tile, and inserts around one cell across tile
+    /// borders, skip the hash.
+    inserted: ParityMemo<u32>,
 }
 
 /// A copy with the original's spare capacity: inserts into a clone grow
@@ -87,8 +87,7 @@ impl<T: Clone> Clone for CellTable<T> {
             free_tiles: self.free_tiles.clone(),
             values,
             keys,
-            insert_keys: self.insert_keys,
-            insert_tiles: self.insert_tiles,
+            inserted: self.inserted,
         }
     }
 }
@@ -120,8 +119,7 @@ impl<T> Default for CellTable<T> {
             free_tiles: Vec::new(),
             values: Vec::new(),
             keys: Vec::new(),
-            insert_keys: [NEVER; 4],
-            insert_tiles: [NONE; 4],
+            inserted: ParityMemo::new(NONE),
         }
     }
 }
@@ -195,7 +193,7 @@ impl<T> CellTable<T> {
         self.free_tiles.clear();
         self.values.clear();
         self.keys.clear();
-        self.insert_keys = [NEVER; 4];
+        self.inserted.clear();
     }
 
     /// Sets the value of `key` (replacing any). Unlike
@@ -226,9 +224,8 @@ impl<T> CellTable<T> {
     /// The tile of `key` (a new one when it has none) and its slot there.
     fn tile_of(&mut self, key: CellKey) -> (u32, usize) {
         let (tile, slot) = split(key);
-        let parity = parity(tile);
-        if self.insert_keys[parity] == packed(tile) {
-            return (self.insert_tiles[parity], slot);
+        if let Some(t) = self.inserted.get(tile) {
+            return (t, slot);
         }
         let t = match self.tiles.get(&tile).copied() {
             Some(t) => t,
@@ -245,8 +242,7 @@ impl<T> CellTable<T> {
                 t
             }
         };
-        self.insert_keys[parity] = packed(tile);
-        self.insert_tiles[parity] = t;
+        self.inserted.set(tile, t);
         (t, slot)
     }
 
@@ -270,10 +266,7 @@ impl<T> CellTable<T> {
         self.used[t as usize] -= 1;
         if self.used[t as usize] == 0 {
             self.tiles.remove(&tile);
-            let parity = parity(tile);
-            if self.insert_keys[parity] == packed(tile) {
-                self.insert_keys[parity] = NEVER;
-            }
+            self.inserted.forget(tile);
             self.free_tiles.push(t);
         }
         // Keep the values contiguous: move the last one into the hole.
@@ -318,28 +311,10 @@ impl<T> CellTable<T> {
     pub fn cursor(&self) -> Cursor<'_, T> {
         Cursor {
             table: self,
-            keys: [NEVER; 4],
-            tiles: [NONE; 4],
+            tiles: ParityMemo::new(NONE),
         }
     }
 }
-
-/// Which of the 4 remembered entries a tile (or block) index uses: its
-/// parity `(x mod 2) + 2 (y mod 2)`. Any 2 × 2 indices have one of each.
-#[inline(always)]
-pub(crate) fn parity(index: (i32, i32)) -> usize {
-    ((index.0 & 1) | ((index.1 & 1) << 1)) as usize & 3
-}
-
-/// A tile index packed into one word (one compare).
-#[inline(always)]
-fn packed(tile: (i32, i32)) -> u64 {
-    (u64::from(tile.0 as u32) << 32) | u64::from(tile.1 as u32)
-}
-
-/// No tile index packs to this: |index| ≤ 2²⁷ for keys within
-/// [`crate::key::MAX_INDEX`], never `i32::MIN`.
-const NEVER: u64 = 0x8000_0000_8000_0000;
 
 /// No tile (out of the slots' range).
 const NONE: u32 = u32::MAX;
@@ -352,10 +327,8 @@ const NONE: u32 = u32::MAX;
 #[derive(Debug)]
 pub struct Cursor<'a, T> {
     table: &'a CellTable<T>,
-    /// Per parity: the packed index of the tile remembered ([`NEVER`]:
-    /// none yet), and its tile ([`NONE`]: the table has none there).
-    keys: [u64; 4],
-    tiles: [u32; 4],
+    /// Per parity: the tile remembered ([`NONE`]: the table has none there).
+    tiles: ParityMemo<u32>,
 }
 
 impl<'a, T> Cursor<'a, T> {
@@ -374,11 +347,9 @@ impl<'a, T> Cursor<'a, T> {
     /// the remembered tiles.
     #[inline(always)]
     fn tile_index(&mut self, tile: (i32, i32)) -> u32 {
-        let parity = parity(tile);
-        if self.keys[parity] == packed(tile) {
-            self.tiles[parity]
-        } else {
-            self.find_tile(tile, parity)
+        match self.tiles.get(tile) {
+            Some(t) => t,
+            None => self.find_tile(tile),
         }
     }
 
@@ -497,11 +468,9 @@ impl<'a, T> Cursor<'a, T> {
     /// The hashed look-up of a tile not remembered (kept out of line, so
     /// the common path inlines into the matcher's loop).
     #[inline(never)]
-    fn find_tile(&mut self, tile: (i32, i32), parity: usize) -> u32 {
+    fn find_tile(&mut self, tile: (i32, i32)) -> u32 {
         let t = self.table.tiles.get(&tile).copied().unwrap_or(NONE);
-        let p = parity & 3;
-        self.keys[p] = packed(tile);
-        self.tiles[p] = t;
+        self.tiles.set(tile, t);
         t
     }
 }
