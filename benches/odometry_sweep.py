@@ -1,0 +1,106 @@
+"""``ndtgrid.Odometry`` over the benchmark logs once per setting: time against accuracy.
+
+Each setting is a set of ``OdometryConfig`` keyword arguments (the rest default, 2 cm
+cells), e.g. ``"insert_distance=0.2 insert_angle=0.1745 map_window=100"`` (angles in
+radians, as the config takes them) or ``"levels=4"``; the empty setting ``""`` is the
+default configuration. For each log and setting this prints the time of the loop (the
+mapper read at the end included), the scans inserted into the loop's map, the scans whose
+kept match ran the rotational multi-start, and the relation error of
+``benches/datasets.py``. Results are in BENCHMARK.md, "Speed".
+
+Run from the repository root::
+
+    python benches/odometry_sweep.py --settings "" "levels=4"
+    python benches/odometry_sweep.py --datasets intel aces --settings "" "map_window=100"
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import sys
+from pathlib import Path
+from typing import Any
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from datasets import DATA, DATASETS, Run, machine, run_ndtgrid
+
+import ndtgrid
+from ndtgrid.evaluation import RelationSummary, relation_errors
+from ndtgrid.io import read_benchmark_index, read_benchmark_split
+
+
+def setting(text: str) -> dict[str, Any]:
+    """``"name=value name=value"`` as ``OdometryConfig`` keyword arguments (integers,
+    floats, ``inf``, ``None``, ``true``/``false``); checked by building the config."""
+    kwargs: dict[str, Any] = {}
+    for item in text.split():
+        name, sep, value = item.partition("=")
+        if not sep:
+            raise argparse.ArgumentTypeError(f"{item!r} is not name=value")
+        low = value.lower()
+        parsed: Any
+        if low in ("none", "true", "false"):
+            parsed = {"none": None, "true": True, "false": False}[low]
+        else:
+            try:
+                parsed = int(value)
+            except ValueError:
+                try:
+                    parsed = float(value)
+                except ValueError as e:
+                    raise argparse.ArgumentTypeError(f"{item!r}: not a number") from e
+        kwargs[name] = parsed
+    try:
+        ndtgrid.OdometryConfig(**kwargs)
+    except (TypeError, ValueError) as e:
+        raise argparse.ArgumentTypeError(f"setting {text!r}: {e}") from e
+    return kwargs
+
+
+def run(name: str, kwargs: dict[str, Any], odometry: bool) -> tuple[Run, RelationSummary]:
+    """The loop over log ``name`` with these settings, and its relation error."""
+    stem = DATASETS[name][0]
+    scans = list(read_benchmark_split(DATA / f"{name}.tar.gz"))
+    if not odometry:
+        scans = [dataclasses.replace(s, odom=None) for s in scans]
+    index = read_benchmark_index(DATA / f"{stem}__index.csv")
+    ours = run_ndtgrid(scans, ndtgrid.OdometryConfig(**kwargs))
+    return ours, relation_errors(ours.poses[index.raw_scan], index.corrected).summary()
+
+
+def label(kwargs: dict[str, Any]) -> str:
+    """A setting as the table shows it."""
+    return " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in kwargs.items())
+
+
+def main() -> None:
+    """Parse the options, run the sweep, print a Markdown table."""
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--datasets", nargs="+", default=list(DATASETS), choices=list(DATASETS))
+    ap.add_argument("--settings", nargs="+", type=setting, default=[{}])
+    ap.add_argument("--no-odometry", action="store_true", help="drop the logs' odometry")
+    args = ap.parse_args()
+    if not DATA.is_dir():
+        sys.exit(f"no benchmark logs at {DATA} (../shared/data/real beside the project)")
+    print(f"Machine: {machine()}; odometry {'off' if args.no_odometry else 'on'}\n")
+    print(
+        "| log | setting | loop [s] | inserted | multi-starts | translation [m] | rotation [deg] |"
+    )
+    print("|---|---|---:|---:|---:|---|---|")
+    for name in args.datasets:
+        for kwargs in args.settings:
+            ours, e = run(name, kwargs, not args.no_odometry)
+            print(
+                f"| {DATASETS[name][1]} | {label(kwargs) or 'default'} | {ours.seconds:.2f} "
+                f"| {ours.insertions} of {len(ours.poses)} | {ours.multi_starts} "
+                f"| {e.translation_mean:.3f} ± {e.translation_std:.3f} (max "
+                f"{e.translation_max:.3f}) | {e.rotation_mean:.2f} ± {e.rotation_std:.2f} "
+                f"(max {e.rotation_max:.2f}) |",
+                flush=True,
+            )
+
+
+if __name__ == "__main__":
+    main()
