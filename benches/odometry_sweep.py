@@ -75,29 +75,46 @@ def label(kwargs: dict[str, Any]) -> str:
     return " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in kwargs.items())
 
 
-def main() -> None:
-    """Parse the options, run the sweep, print a Markdown table."""
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+def parser(description: str) -> argparse.ArgumentParser:
+    """The options every sweep over the logs takes: ``--datasets``, ``--no-odometry``."""
+    ap = argparse.ArgumentParser(description=description)
     ap.add_argument("--datasets", nargs="+", default=list(DATASETS), choices=list(DATASETS))
-    ap.add_argument("--settings", nargs="+", type=setting, default=[{}])
     ap.add_argument("--no-odometry", action="store_true", help="drop the logs' odometry")
-    args = ap.parse_args()
+    return ap
+
+
+def begin(args: argparse.Namespace, columns: list[str], align: list[str]) -> None:
+    """Exits when the logs are absent; else prints the machine and the table's head,
+    ``columns`` (with the two error columns appended) aligned as ``align``."""
     if not DATA.is_dir():
         sys.exit(f"no benchmark logs at {DATA} (../shared/data/real beside the project)")
     print(f"Machine: {machine()}; odometry {'off' if args.no_odometry else 'on'}\n")
-    print(
-        "| log | setting | loop [s] | inserted | multi-starts | translation [m] | rotation [deg] |"
+    print("| " + " | ".join([*columns, "translation [m]", "rotation [deg]"]) + " |")
+    print("|" + "|".join([*align, "---", "---"]) + "|")
+
+
+def error_cells(e: RelationSummary) -> str:
+    """The relation error's two table cells: translation and rotation, mean ± std (max)."""
+    return (
+        f"{e.translation_mean:.3f} ± {e.translation_std:.3f} (max {e.translation_max:.3f}) "
+        f"| {e.rotation_mean:.2f} ± {e.rotation_std:.2f} (max {e.rotation_max:.2f})"
     )
-    print("|---|---|---:|---:|---:|---|---|")
+
+
+def main() -> None:
+    """Parse the options, run the sweep, print a Markdown table."""
+    ap = parser(__doc__.split("\n")[0])
+    ap.add_argument("--settings", nargs="+", type=setting, default=[{}])
+    args = ap.parse_args()
+    columns = ["log", "setting", "loop [s]", "inserted", "multi-starts"]
+    begin(args, columns, ["---", "---", "---:", "---:", "---:"])
     for name in args.datasets:
         for kwargs in args.settings:
             ours, e = run(name, kwargs, not args.no_odometry)
             print(
                 f"| {DATASETS[name][1]} | {label(kwargs) or 'default'} | {ours.seconds:.2f} "
                 f"| {ours.insertions} of {len(ours.poses)} | {ours.multi_starts} "
-                f"| {e.translation_mean:.3f} ± {e.translation_std:.3f} (max "
-                f"{e.translation_max:.3f}) | {e.rotation_mean:.2f} ± {e.rotation_std:.2f} "
-                f"(max {e.rotation_max:.2f}) |",
+                f"| {error_cells(e)} |",
                 flush=True,
             )
 

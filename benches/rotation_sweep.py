@@ -18,60 +18,42 @@ Run from the repository root::
 
 from __future__ import annotations
 
-import argparse
-import dataclasses
 import math
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from datasets import DATA, DATASETS, Run, machine, run_ndtgrid
+from datasets import DATASETS, Run
+from odometry_sweep import begin, error_cells, parser
+from odometry_sweep import run as run_setting
 
-import ndtgrid
-from ndtgrid.evaluation import RelationSummary, relation_errors
-from ndtgrid.io import read_benchmark_index, read_benchmark_split
+from ndtgrid.evaluation import RelationSummary
 
 VALUES = (0.15, 0.10, 0.08, 0.05)
 
 
 def run(name: str, search: float, gate: float, odometry: bool) -> tuple[Run, RelationSummary]:
     """The loop over log ``name`` with these settings, and its relation error."""
-    stem = DATASETS[name][0]
-    scans = list(read_benchmark_split(DATA / f"{name}.tar.gz"))
-    if not odometry:
-        scans = [dataclasses.replace(s, odom=None) for s in scans]
-    index = read_benchmark_index(DATA / f"{stem}__index.csv")
-    config = ndtgrid.OdometryConfig(coarse_rotation_search=search, coarse_rotation_gate=gate)
-    ours = run_ndtgrid(scans, config)
-    return ours, relation_errors(ours.poses[index.raw_scan], index.corrected).summary()
+    setting = {"coarse_rotation_search": search, "coarse_rotation_gate": gate}
+    return run_setting(name, setting, odometry)
 
 
 def main() -> None:
     """Parse the options, run the sweep, print a Markdown table."""
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--datasets", nargs="+", default=list(DATASETS), choices=list(DATASETS))
+    ap = parser(__doc__.split("\n")[0])
     ap.add_argument("--values", nargs="+", type=float, default=list(VALUES))
     ap.add_argument("--gates", nargs="+", type=float, default=[math.inf])
-    ap.add_argument("--no-odometry", action="store_true", help="drop the logs' odometry")
     args = ap.parse_args()
-    if not DATA.is_dir():
-        sys.exit(f"no benchmark logs at {DATA} (../shared/data/real beside the project)")
-    print(f"Machine: {machine()}; odometry {'off' if args.no_odometry else 'on'}\n")
-    print(
-        "| log | search [rad] | gate | loop [s] | multi-starts | translation [m] | rotation [deg] |"
-    )
-    print("|---|---:|---:|---:|---:|---|---|")
+    columns = ["log", "search [rad]", "gate", "loop [s]", "multi-starts"]
+    begin(args, columns, ["---", "---:", "---:", "---:", "---:"])
     for name in args.datasets:
         for value in args.values:
             for gate in args.gates:
                 ours, e = run(name, value, gate, not args.no_odometry)
                 print(
                     f"| {DATASETS[name][1]} | {value:g} | {gate:g} | {ours.seconds:.2f} "
-                    f"| {ours.multi_starts} of {len(ours.poses)} "
-                    f"| {e.translation_mean:.3f} ± {e.translation_std:.3f} (max "
-                    f"{e.translation_max:.3f}) | {e.rotation_mean:.2f} ± {e.rotation_std:.2f} "
-                    f"(max {e.rotation_max:.2f}) |",
+                    f"| {ours.multi_starts} of {len(ours.poses)} | {error_cells(e)} |",
                     flush=True,
                 )
 
