@@ -33,7 +33,7 @@ from ndtgrid.io import read_benchmark_index, read_benchmark_split
 
 def setting(text: str) -> dict[str, Any]:
     """``"name=value name=value"`` as ``OdometryConfig`` keyword arguments (integers,
-    floats, ``inf``, ``None``, ``true``/``false``); checked by building the config."""
+    floats, ``inf``, ``None``, ``true``/``false``); checked by building a loop with them."""
     kwargs: dict[str, Any] = {}
     for item in text.split():
         name, sep, value = item.partition("=")
@@ -53,7 +53,7 @@ def setting(text: str) -> dict[str, Any]:
                     raise argparse.ArgumentTypeError(f"{item!r}: not a number") from e
         kwargs[name] = parsed
     try:
-        ndtgrid.OdometryConfig(**kwargs)
+        ndtgrid.Odometry(cell_size=0.02, config=ndtgrid.OdometryConfig(**kwargs))
     except (TypeError, ValueError) as e:
         raise argparse.ArgumentTypeError(f"setting {text!r}: {e}") from e
     return kwargs
