@@ -57,13 +57,15 @@ PROGRESS_EVERY = 2000
 @dataclass
 class Run:
     """Poses of one method over a log, its time, and (ours) the scans whose match ran the
-    rotational multi-start (``OdometryStep.multi_start``) and the scans inserted into the
-    loop's map (``Odometry.insertions``)."""
+    rotational multi-start (``OdometryStep.multi_start``), the scans added to the loop's
+    map (``Odometry.insertions``) and those its matching grid took
+    (``Odometry.grid_insertions``)."""
 
     poses: F64
     seconds: float
     multi_starts: int = 0
     insertions: int = 0
+    grid_insertions: int = 0
 
 
 def progress(label: str, k: int, n: int, start: float) -> None:
@@ -85,7 +87,8 @@ def run_ndtgrid(scans: list[Scan], config: ndtgrid.OdometryConfig | None = None)
         multi_starts += step is not None and step.multi_start
         progress("ndtgrid", k, len(scans), start)
     _ = odo.mapper
-    return Run(odo.poses, time.perf_counter() - start, multi_starts, odo.insertions)
+    seconds = time.perf_counter() - start
+    return Run(odo.poses, seconds, multi_starts, odo.insertions, odo.grid_insertions)
 
 
 def matrix(p: F64) -> F64:

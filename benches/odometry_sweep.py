@@ -4,9 +4,9 @@ Each setting is a set of ``OdometryConfig`` keyword arguments (the rest default,
 cells), e.g. ``"insert_distance=0.2 insert_angle=0.1745 map_window=100"`` (angles in
 radians, as the config takes them) or ``"levels=4"``; the empty setting ``""`` is the
 default configuration. For each log and setting this prints the time of the loop (the
-mapper read at the end included), the scans inserted into the loop's map, the scans whose
-kept match ran the rotational multi-start, and the relation error of
-``benches/datasets.py``. Results are in BENCHMARK.md, "Speed".
+mapper read at the end included), the scans added to the loop's map (and of them, taken
+by its matching grid), the scans whose kept match ran the rotational multi-start, and the
+relation error of ``benches/datasets.py``. Results are in BENCHMARK.md, "Speed".
 
 Run from the repository root::
 
@@ -106,14 +106,15 @@ def main() -> None:
     ap = parser(__doc__.split("\n")[0])
     ap.add_argument("--settings", nargs="+", type=setting, default=[{}])
     args = ap.parse_args()
-    columns = ["log", "setting", "loop [s]", "inserted", "multi-starts"]
+    columns = ["log", "setting", "loop [s]", "added (matching grid)", "multi-starts"]
     begin(args, columns, ["---", "---", "---:", "---:", "---:"])
     for name in args.datasets:
         for kwargs in args.settings:
             ours, e = run(name, kwargs, not args.no_odometry)
             print(
                 f"| {DATASETS[name][1]} | {label(kwargs) or 'default'} | {ours.seconds:.2f} "
-                f"| {ours.insertions} of {len(ours.poses)} | {ours.multi_starts} "
+                f"| {ours.insertions} ({ours.grid_insertions}) of {len(ours.poses)} "
+                f"| {ours.multi_starts} "
                 f"| {error_cells(e)} |",
                 flush=True,
             )

@@ -112,16 +112,26 @@ def test_multi_start_runs_on_every_scan_or_behind_the_gate() -> None:
 
 def test_map_window_bounds_the_map() -> None:
     truth = trajectory(80)
-    bounded = ndtgrid.Odometry(config=ndtgrid.OdometryConfig(map_window=5, insert_distance=0.02))
-    unbounded = ndtgrid.Odometry(config=ndtgrid.OdometryConfig(map_window=0, insert_distance=0.02))
-    peak = 0
+    # The map (the mapper's) and the matching grid, each with its window.
+    def config(window: int) -> ndtgrid.OdometryConfig:
+        return ndtgrid.OdometryConfig(
+            map_window=window,
+            insert_distance=0.02,
+            match_map_window=window,
+            match_insert_distance=0.02,
+        )
+
+    bounded, unbounded = ndtgrid.Odometry(config=config(5)), ndtgrid.Odometry(config=config(0))
+    peak, mapped = 0, 0
     for k, pose in enumerate(truth):
         r, a = polar(pose, seed=k, noise=0.01)
         bounded.step(r, a)
         unbounded.step(r, a)
         peak = max(peak, len(bounded))
-    assert peak <= 5 * BEAMS
+        mapped = max(mapped, len(bounded.mapper.grid))
+    assert peak <= 5 * BEAMS and mapped <= 5 * BEAMS
     assert len(unbounded) > 2 * peak
+    assert len(unbounded.mapper.grid) > 2 * mapped
     assert unbounded.grid().cell_size == 0.02 and len(unbounded.grid()) == len(unbounded)
 
 

@@ -985,6 +985,9 @@ class OdometryLoop:
         insert_distance: float | None = None,
         insert_angle: float | None = None,
         map_window: int | None = None,
+        match_insert_distance: float | None = None,
+        match_insert_angle: float | None = None,
+        match_map_window: int | None = None,
         min_match_ratio: float | None = None,
         bootstrap_insertions: int | None = None,
         rotation_search: float | None = None,
@@ -1031,6 +1034,9 @@ class OdometryLoop:
     @property
     def insertions(self) -> int:
         """Scans added to the map so far."""
+    @property
+    def grid_insertions(self) -> int:
+        """Scans the grid the loop matches against took so far."""
     def __len__(self) -> int:
         """Cells in the map now."""
     def grid(self) -> NdtGrid:

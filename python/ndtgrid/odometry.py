@@ -46,6 +46,20 @@ class OdometryConfig:
         cell hit again stays, with all its points), so at most ``map_window * B`` cells for
         ``B``-beam scans however long the run; 0 keeps every cell (memory then grows with
         the mapped area, and with the drift when a place is revisited).
+    match_insert_distance : float, default 0.15
+        The grid the loop matches against (:meth:`Odometry.grid`) has a policy of its own:
+        it takes a scan when the pose moved this far since the last scan it took [m] ...
+        The map above (the mapper's) is the one people use: sub-grid objects need every
+        view the §V elimination can get. With ``match_map_window`` 130 and matches up to
+        32 cm cells (``levels``), measured on the five benchmark logs against the map's
+        own 0.1 m, 5 degrees, 200 and 64 cm: relation errors within 1 mm with the logs'
+        odometry, lower on three logs without it, and a third fewer inserts and window
+        removals for the matching grid (``BENCHMARK.md``, "Speed", session 14).
+    match_insert_angle : float, default 7.5 degrees
+        ... or turned this much [rad].
+    match_map_window : int, default 130
+        The matching grid keeps the cells hit by the last ``match_map_window`` scans it
+        took (0: every cell).
     min_match_ratio : float, default 0.3
         A match is used when at least this fraction of the scan's valid points found a
         distribution; otherwise the pose is the prediction. In [0, 1].
@@ -99,7 +113,10 @@ class OdometryConfig:
         Largest rotation per Newton step [rad].
     levels : int, optional
         Pyramid levels the matcher runs coarse to fine (see ``NdtGrid.match``); by
-        default as many as keep the coarsest cell at most 0.64 m.
+        default as many as keep the coarsest cell at most 0.32 m (5 on 2 cm cells; a match
+        alone goes up to 0.64 m): from a motion prior the 64 cm stage adds little, and
+        without odometry it made the benchmark logs' matches worse (``BENCHMARK.md``,
+        "Speed", session 14).
     coarse_rotation_search : float, default 0.15
         The matcher's rotational multi-start on its coarsest level [rad]
         (``NdtGrid.match(rotation_search=...)``); 0 turns it off.
@@ -151,6 +168,9 @@ class OdometryConfig:
     insert_distance: float = 0.1
     insert_angle: float = math.radians(5.0)
     map_window: int = 200
+    match_insert_distance: float = 0.15
+    match_insert_angle: float = math.radians(7.5)
+    match_map_window: int = 130
     min_match_ratio: float = 0.3
     bootstrap_insertions: int = 2
     rotation_search: float = 0.0
@@ -207,9 +227,11 @@ class Odometry:
     rotation around the prediction, match the scan against the map from there (Newton on
     eq. 1 with §IV-A), fall back to (or, when the two priors disagree, compare with) the
     constant-velocity prior, and add the scan to the map when the pose moved
-    ``insert_distance`` or turned ``insert_angle`` since the last added scan. The first
-    scan sits at its odometry pose (or the origin) and starts the map. The map keeps the
-    last ``map_window`` added scans' cells (memory bound).
+    ``insert_distance`` or turned ``insert_angle`` since the last added scan (the grid it
+    matches against takes a scan every ``match_insert_distance`` or
+    ``match_insert_angle``). The first scan sits at its odometry pose (or the origin) and
+    starts the map. The map keeps the last ``map_window`` added scans' cells, the
+    matching grid the last ``match_map_window`` of its own (memory bound).
 
     Parameters
     ----------
@@ -320,6 +342,11 @@ class Odometry:
     def insertions(self) -> int:
         """Scans added to the map so far."""
         return int(self._loop.insertions)
+
+    @property
+    def grid_insertions(self) -> int:
+        """Scans the grid the loop matches against took so far."""
+        return int(self._loop.grid_insertions)
 
     def __len__(self) -> int:
         """Cells in the map now."""

@@ -53,6 +53,7 @@ pub mod shape;
 pub mod shaped;
 pub mod solver;
 pub mod table;
+pub mod window;
 
 pub use cell::{CellStats, Gaussian};
 pub use error::{NdtError, Result};

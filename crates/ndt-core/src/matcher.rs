@@ -47,6 +47,16 @@ pub const DEFAULT_SHAPE_CELL: f64 = 0.32;
 /// stage must still see a room's walls as separate structures.
 pub const AUTO_COARSEST_CELL: f64 = 0.64;
 
+/// The most pyramid levels, at least 1 and at most `available`, whose
+/// coarsest cell is at most `coarsest` \[m\] on a grid of `cell_size` m
+/// cells (level `l` has cells `2^l` times the fine size).
+pub fn levels_up_to(cell_size: f64, coarsest: f64, available: usize) -> usize {
+    (1..=available)
+        .take_while(|&l| cell_size * f64::from(1u32 << (l - 1)) <= coarsest * 1.0001)
+        .last()
+        .unwrap_or(1)
+}
+
 /// Voxel side, as a fraction of the coarsest level's cell, on which the
 /// rotated starts of the rotational multi-start are first solved
 /// ([`crate::reduce::voxel_runs`]). Measured with `benches/convergence.py`'s
@@ -667,12 +677,7 @@ impl NdtGrid {
         }
         let levels = match options.levels {
             Some(l) => l as usize,
-            None => (1..=self.levels())
-                .take_while(|&l| {
-                    self.cell_size() * f64::from(1u32 << (l - 1)) <= AUTO_COARSEST_CELL * 1.0001
-                })
-                .last()
-                .unwrap_or(1),
+            None => levels_up_to(self.cell_size(), AUTO_COARSEST_CELL, self.levels()),
         };
         if levels == 0 || levels > self.levels() {
             return Err(NdtError::InvalidOption {

@@ -13,27 +13,33 @@
 //! [`OdometryConfig::map_window`] `= W > 0` the map keeps only the cells hit
 //! by the last `W` inserted scans (a cell hit again is kept, with all its
 //! points): at most `W × B` cells for `B`-beam scans, whatever the length of
-//! the run. Besides the grid the loop keeps `3 × 8` bytes per scan (the
-//! poses) and `≤ W × B` cell keys.
+//! the run ([`crate::window`]); the grid the loop matches against likewise
+//! with [`OdometryConfig::match_map_window`]. Besides the grids the loop
+//! keeps `3 × 8` bytes per scan (the poses) and the windows' cell keys.
 
 use std::collections::VecDeque;
-
-use rustc_hash::FxHashMap;
 
 use crate::error::{check_bound, check_finite, NdtError, Result};
 use crate::grid::NdtGrid;
 use crate::key::CellKey;
 use crate::mapper::{Mapper, MapperOptions};
 use crate::mapworker::{MapperHost, MapperView};
-use crate::matcher::{MatchOptions, MatchResult};
+use crate::matcher::{levels_up_to, MatchOptions, MatchResult};
 use crate::ranges::BeamDirections;
 use crate::se2::Pose2;
+use crate::window::CellWindow;
 
 /// The default [`OdometryConfig::coarse_rotation_gate`].
 pub const DEFAULT_ROTATION_GATE: f64 = 0.8;
 
 /// σ floor \[m\] of the loop's matcher (see [`OdometryConfig::matcher`]).
 pub const ODOMETRY_SIGMA_FLOOR: f64 = 0.005;
+
+/// Largest coarsest-level cell \[m\] of the loop's matches when
+/// [`MatchOptions::levels`] is `None` (see [`OdometryConfig::matcher`]): 5
+/// levels on 2 cm cells, where a match alone takes 6 (up to
+/// [`crate::matcher::AUTO_COARSEST_CELL`]).
+pub const ODOMETRY_COARSEST_CELL: f64 = 0.32;
 
 /// Most rotations tried on each side of the prediction by the rotation search.
 const MAX_ROTATION_CANDIDATES: f64 = 1000.0;
@@ -64,6 +70,30 @@ pub struct OdometryConfig {
     /// The map keeps the cells hit by the last `map_window` added scans
     /// (0 = keep every cell; see the module's memory bound).
     pub map_window: usize,
+    /// The grid the loop matches against ([`Odometry::grid`]) has a policy
+    /// of its own: it takes a scan when the pose moved at least this far
+    /// since the last scan it took \[m\]… (the map above, the mapper's, is
+    /// the one people use: sub-grid objects need every view of them the §V
+    /// elimination can get).
+    ///
+    /// 0.15 m, 7.5° and a window of 130 scans (about as far back along the
+    /// path as 200 scans 10 cm apart), with matches up to 32 cm cells
+    /// ([`OdometryConfig::matcher`]): measured with `benches/odometry_sweep.py`
+    /// on the five benchmark logs (BENCHMARK.md, "Speed", session 14) against
+    /// the map's own 0.1 m, 5°, 200 and 64 cm. With the logs' odometry the
+    /// relation errors stayed within 1 mm (Intel 0.028 against 0.030 m, MIT
+    /// Killian 0.042 against 0.045 m); without it they were lower on three
+    /// logs (ACES 0.056 against 0.072 m, MIT Killian 0.049 against 0.061 m),
+    /// equal on FR079 and 1 mm higher on MIT CSAIL; the matching grid's
+    /// inserts and window removals, about half of the loop's own thread,
+    /// came a third less often. The same policy for the mapper lost a 1 cm
+    /// stick of `ndtgrid demo`.
+    pub match_insert_distance: f64,
+    /// …or turned at least this much \[rad\].
+    pub match_insert_angle: f64,
+    /// The matching grid keeps the cells hit by the last `match_map_window`
+    /// scans it took (0 = every cell).
+    pub match_map_window: usize,
     /// A match is used only when at least this fraction of the scan's valid
     /// points found a distribution at the solution; otherwise the pose is
     /// the prediction. In `[0, 1]`. (While the map is young, see
@@ -135,7 +165,12 @@ pub struct OdometryConfig {
     /// 2 cm). For the same reason fine cells keep their own covariance
     /// (`shape_cell = 0`, see [`crate::shape`]), and directions are frozen
     /// only below [`crate::degeneracy::DEGENERACY_RATIO`] (see
-    /// [`crate::degeneracy::FREEZE_RATIO`]).
+    /// [`crate::degeneracy::FREEZE_RATIO`]). With `levels: None` it matches
+    /// on as many levels as keep the coarsest cell at most
+    /// [`ODOMETRY_COARSEST_CELL`] (5 levels, 2–32 cm, on 2 cm cells), not
+    /// 64 cm as a match alone: from a motion prior the 64 cm stage adds
+    /// little, and without odometry it made the benchmark logs' matches
+    /// worse (BENCHMARK.md, "Speed", session 14).
     pub matcher: MatchOptions,
     /// The §V elimination applied to every inserted scan for the map the
     /// loop builds ([`Odometry::mapper`]; on by default: `outlier_filter =
@@ -173,6 +208,9 @@ impl Default for OdometryConfig {
             insert_distance: 0.1,
             insert_angle: 5f64.to_radians(),
             map_window: 200,
+            match_insert_distance: 0.15,
+            match_insert_angle: 7.5f64.to_radians(),
+            match_map_window: 130,
             min_match_ratio: 0.3,
             bootstrap_insertions: 2,
             rotation_search: 0.0,
@@ -205,6 +243,8 @@ impl OdometryConfig {
         };
         non_negative("insert_distance", self.insert_distance)?;
         non_negative("insert_angle", self.insert_angle)?;
+        non_negative("match_insert_distance", self.match_insert_distance)?;
+        non_negative("match_insert_angle", self.match_insert_angle)?;
         non_negative("min_range", self.min_range)?;
         if self.max_range.is_nan() || self.max_range <= self.min_range {
             return Err(NdtError::InvalidOption {
@@ -264,6 +304,32 @@ impl OdometryConfig {
     }
 }
 
+/// Whether `pose` moved at least `distance` \[m\] or turned at least
+/// `angle` \[rad\] from `last` (always, with no `last`).
+fn moved(last: Option<Pose2>, pose: Pose2, distance: f64, angle: f64) -> bool {
+    last.is_none_or(|at| {
+        let d = at.between(pose);
+        d.x.hypot(d.y) >= distance || d.theta.abs() >= angle
+    })
+}
+
+/// The cells the scan-frame `points` seen from `pose` fall in (cells of
+/// `cell_size` m), each once, in first-touch order; points beyond the
+/// lattice are left out (the mapper's checks refuse such a scan first).
+fn scan_keys(points: &[[f64; 2]], pose: Pose2, cell_size: f64) -> Vec<CellKey> {
+    let inv = 1.0 / cell_size;
+    let sin_cos = pose.theta.sin_cos();
+    let mut seen = rustc_hash::FxHashSet::default();
+    points
+        .iter()
+        .filter_map(|p| {
+            let w = pose.transform_with(sin_cos, nalgebra::Vector2::new(p[0], p[1]));
+            CellKey::of(w, inv)
+        })
+        .filter(|k| seen.insert(*k))
+        .collect()
+}
+
 /// What one [`Odometry::step`] did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StepOutcome {
@@ -304,12 +370,12 @@ pub struct Odometry {
     mapper: MapperHost,
     poses: Vec<Pose2>,
     last_odom: Option<Pose2>,
+    /// Where the map and the matching grid took their last scans.
     last_insert: Option<Pose2>,
-    insertions: u64,
-    /// Insertion number that last hit each cell (only with a window).
-    stamps: FxHashMap<CellKey, u64>,
-    /// Cells hit by each of the last `map_window` insertions.
-    history: VecDeque<(u64, Vec<CellKey>)>,
+    last_grid_insert: Option<Pose2>,
+    /// The memory bounds of the map (the mapper's) and of the matching grid.
+    window: CellWindow,
+    grid_window: CellWindow,
     /// Score of eq. (1) per point of the last [`GATE_HISTORY`] accepted
     /// matches (see [`OdometryConfig::coarse_rotation_gate`]).
     scores: VecDeque<f64>,
@@ -336,9 +402,9 @@ impl Odometry {
             poses: Vec::new(),
             last_odom: None,
             last_insert: None,
-            insertions: 0,
-            stamps: FxHashMap::default(),
-            history: VecDeque::new(),
+            last_grid_insert: None,
+            window: CellWindow::default(),
+            grid_window: CellWindow::default(),
             scores: VecDeque::with_capacity(GATE_HISTORY + 1),
             beams: BeamDirections::default(),
         })
@@ -384,7 +450,43 @@ impl Odometry {
 
     /// Scans added to the map so far.
     pub fn insertions(&self) -> u64 {
-        self.insertions
+        self.window.scans()
+    }
+
+    /// Scans the matching grid took so far
+    /// ([`OdometryConfig::match_insert_distance`]; 0 with
+    /// [`OdometryConfig::match_filtered_map`], which matches against the
+    /// map itself).
+    pub fn grid_insertions(&self) -> u64 {
+        self.grid_window.scans()
+    }
+
+    /// Scans taken by the map the loop matches against.
+    fn matched_insertions(&self) -> u64 {
+        if self.config.match_filtered_map {
+            self.insertions()
+        } else {
+            self.grid_insertions()
+        }
+    }
+
+    /// The loop's matcher options: [`OdometryConfig::matcher`] with its
+    /// level count resolved (`None`: coarsest cell at most
+    /// [`ODOMETRY_COARSEST_CELL`]).
+    fn matcher(&self) -> MatchOptions {
+        let m = self.config.matcher;
+        let levels = m.levels.unwrap_or_else(|| {
+            let l = levels_up_to(
+                self.config.cell_size,
+                ODOMETRY_COARSEST_CELL,
+                crate::grid::DEFAULT_LEVELS,
+            );
+            u32::try_from(l).unwrap_or(1)
+        });
+        MatchOptions {
+            levels: Some(levels),
+            ..m
+        }
     }
 
     /// The constant-velocity prior: the last pose moved by the last pose
@@ -417,7 +519,7 @@ impl Odometry {
         bar: Option<f64>,
     ) -> Result<Attempt> {
         let start = self.rotation_start(points, prediction)?;
-        let full = &self.config.matcher;
+        let full = &self.matcher();
         if let Some(bar) = bar {
             let quick = MatchOptions {
                 rotation_search: 0.0,
@@ -451,7 +553,7 @@ impl Odometry {
     /// [`OdometryConfig::bootstrap_insertions`]).
     fn passes(&self, res: &MatchResult, points: usize) -> bool {
         let ratio = res.num_matched as f64 / points as f64;
-        let young = self.insertions < self.config.bootstrap_insertions as u64;
+        let young = self.matched_insertions() < self.config.bootstrap_insertions as u64;
         res.num_matched > 0 && (ratio >= self.config.min_match_ratio || (young && res.converged))
     }
 
@@ -488,14 +590,23 @@ impl Odometry {
     /// [`OdometryConfig::insert_distance`] or turned
     /// [`OdometryConfig::insert_angle`] since the last added scan.
     fn should_insert(&self, pose: Pose2) -> bool {
-        match self.last_insert {
-            None => true,
-            Some(at) => {
-                let d = at.between(pose);
-                d.x.hypot(d.y) >= self.config.insert_distance
-                    || d.theta.abs() >= self.config.insert_angle
-            }
-        }
+        let c = &self.config;
+        moved(self.last_insert, pose, c.insert_distance, c.insert_angle)
+    }
+
+    /// The matching grid's policy: its first scan, then whenever the pose
+    /// moved [`OdometryConfig::match_insert_distance`] or turned
+    /// [`OdometryConfig::match_insert_angle`] since its last (never with
+    /// [`OdometryConfig::match_filtered_map`]).
+    fn grid_takes(&self, pose: Pose2) -> bool {
+        let c = &self.config;
+        !c.match_filtered_map
+            && moved(
+                self.last_grid_insert,
+                pose,
+                c.match_insert_distance,
+                c.match_insert_angle,
+            )
     }
 
     /// The start of the match: the prediction turned by the offset of the
@@ -576,9 +687,8 @@ impl Odometry {
             matched = Some(best.res);
         }
         let inserted = !points.is_empty() && self.should_insert(pose);
-        if inserted {
-            self.insert_points(&points, ranges, angles, pose)?;
-        }
+        let into_grid = !points.is_empty() && self.grid_takes(pose);
+        self.insert_points(&points, ranges, angles, pose, inserted, into_grid)?;
         // Nothing below can fail: the loop changes only now.
         if let Some(res) = matched.as_ref().filter(|_| accepted) {
             self.record_score(res, points.len());
@@ -598,85 +708,72 @@ impl Odometry {
         })
     }
 
-    /// Adds a scan seen from `pose` to the map (insertion, then the memory
-    /// bound), as [`Odometry::step`] does when it inserts. All-or-nothing: on
-    /// error the map is unchanged.
+    /// Adds a scan seen from `pose` to the map and to the matching grid
+    /// (insertions, then the memory bounds), as [`Odometry::step`] does when
+    /// both policies take a scan. All-or-nothing: on error neither changes.
     pub fn update_map(&mut self, ranges: &[f64], angles: &[f64], pose: Pose2) -> Result<()> {
         let points = self.valid_points(ranges, angles)?;
-        self.insert_points(&points, ranges, angles, pose)
+        let into_grid = !self.config.match_filtered_map;
+        self.insert_points(&points, ranges, angles, pose, true, into_grid)
     }
 
     /// [`Odometry::update_map`] with the scan's valid points already taken
     /// from `ranges` and `angles` (as [`Odometry::step`] has them): the one
-    /// place where the maps change.
+    /// place where the maps change. The map (the mapper's) takes the scan
+    /// when `to_map`, the matching grid when `into_grid` (see
+    /// [`OdometryConfig::match_insert_distance`]); each then forgets what
+    /// fell out of its window.
     fn insert_points(
         &mut self,
         points: &[[f64; 2]],
         ranges: &[f64],
         angles: &[f64],
         pose: Pose2,
+        to_map: bool,
+        into_grid: bool,
     ) -> Result<()> {
+        if !(to_map || into_grid) {
+            return Ok(());
+        }
         check_finite("pose", &pose.to_array())?;
         // Both maps check the scan before either changes; then neither
         // insertion can fail (the mapper's only failures are its checks and
         // its grid's, on the same beams).
-        let checked = self.mapper.check_scan(ranges, angles, pose)?;
-        let touched = if self.config.match_filtered_map {
-            // The cells this scan touched (the filter stores a subset of
-            // them), each once.
-            let inv = 1.0 / self.config.cell_size;
-            let sin_cos = pose.theta.sin_cos();
-            let mut seen = rustc_hash::FxHashSet::default();
-            points
-                .iter()
-                .filter_map(|p| {
-                    let w = pose.transform_with(sin_cos, nalgebra::Vector2::new(p[0], p[1]));
-                    CellKey::of(w, inv)
-                })
-                .filter(|k| seen.insert(*k))
-                .collect()
+        let checked = if to_map {
+            Some(self.mapper.check_scan(ranges, angles, pose)?)
         } else {
-            let staged = self.grid.stage(points, pose)?;
-            self.grid.insert_staged(staged)
+            None
         };
-        let stale = self.record_insertion(touched, pose);
-        // The mapper takes the scan, then loses the same stale cells: in
-        // line, or queued behind the loop as one job.
+        let staged = if into_grid {
+            Some(self.grid.stage(points, pose)?)
+        } else {
+            None
+        };
+        // The cells this scan touched, each once, in first-touch order (as
+        // the grid's insert returns them).
+        let mut touched = None;
+        if let Some(staged) = staged {
+            let keys = self.grid.insert_staged(staged);
+            if checked.is_some() {
+                touched = Some(keys.clone());
+            }
+            let stale = self.grid_window.record(keys, self.config.match_map_window);
+            self.grid.remove_cells(&stale);
+            self.last_grid_insert = Some(pose);
+        }
+        let Some(checked) = checked else {
+            return Ok(());
+        };
+        let touched = touched.unwrap_or_else(|| scan_keys(points, pose, self.config.cell_size));
+        let stale = self.window.record(touched, self.config.map_window);
+        self.last_insert = Some(pose);
+        // The mapper takes the scan, then loses its stale cells: in line, or
+        // queued behind the loop as one job.
         self.mapper.update(checked, stale)
     }
 
     fn valid_points(&mut self, ranges: &[f64], angles: &[f64]) -> Result<Vec<[f64; 2]>> {
         let (lo, hi) = (self.config.min_range, self.config.max_range);
         self.beams.points(ranges, angles, lo, hi)
-    }
-
-    /// The memory bound: the matching grid forgets the cells no scan of the
-    /// last `map_window` insertions touched; returns them for the mapper.
-    fn record_insertion(&mut self, touched: Vec<CellKey>, pose: Pose2) -> Vec<CellKey> {
-        self.insertions += 1;
-        self.last_insert = Some(pose);
-        let window = self.config.map_window;
-        if window == 0 {
-            return Vec::new();
-        }
-        let n = self.insertions;
-        for &key in &touched {
-            self.stamps.insert(key, n);
-        }
-        self.history.push_back((n, touched));
-        let mut stale = Vec::new();
-        while self.history.len() > window {
-            let Some((m, keys)) = self.history.pop_front() else {
-                break;
-            };
-            for key in keys {
-                if self.stamps.get(&key) == Some(&m) {
-                    self.stamps.remove(&key);
-                    stale.push(key);
-                }
-            }
-        }
-        self.grid.remove_cells(&stale);
-        stale
     }
 }

@@ -3,7 +3,8 @@
 
 mod common;
 
-use ndt_core::{NdtError, Odometry, OdometryConfig, Pose2};
+use ndt_core::ranges::points_from_ranges;
+use ndt_core::{NdtError, NdtGrid, Odometry, OdometryConfig, Pose2};
 /// Ranges of a beam fan at `pose` inside the square `[-2, 2]²`.
 fn square_scan(pose: Pose2, beams: usize) -> (Vec<f64>, Vec<f64>) {
     let angles: Vec<f64> = (0..beams)
@@ -75,6 +76,53 @@ fn tracks_a_moving_sensor_and_bounds_the_map() {
     }
     assert!(odo.insertions() >= 10);
     assert!(max_cells <= 3 * 361);
+}
+
+#[test]
+fn the_matching_grid_takes_the_scans_its_own_policy_picks() {
+    // Scans added to the map every 5 cm; the matching grid takes one when
+    // 12 cm from the last it took. No windows, so nothing leaves either map.
+    let config = OdometryConfig {
+        map_window: 0,
+        insert_distance: 0.05,
+        insert_angle: 10.0,
+        match_insert_distance: 0.12,
+        match_insert_angle: 10.0,
+        match_map_window: 0,
+        ..OdometryConfig::default()
+    };
+    let mut odo = Odometry::new(config).unwrap();
+    let mut expected = NdtGrid::new(config.cell_size).unwrap();
+    let (mut taken, mut last_taken): (u64, Option<Pose2>) = (0, None);
+    for i in 0..40 {
+        let t = f64::from(i);
+        let truth = Pose2::new(0.02 * t, 0.01 * t, 0.01 * t);
+        let (r, a) = square_scan(truth, 361);
+        let out = odo.step(&r, &a, None).unwrap();
+        let takes = last_taken.is_none_or(|at| {
+            let d = at.between(out.pose);
+            d.x.hypot(d.y) >= 0.12 || d.theta.abs() >= 10.0
+        });
+        if takes {
+            let points = points_from_ranges(&r, &a, config.min_range, config.max_range).unwrap();
+            expected.insert(&points, out.pose).unwrap();
+            (taken, last_taken) = (taken + 1, Some(out.pose));
+        }
+    }
+    assert!(odo.insertions() >= 10, "{}", odo.insertions());
+    assert_eq!(odo.grid_insertions(), taken);
+    assert!(taken >= 4 && taken < odo.insertions(), "{taken}");
+    // The matching grid holds exactly the scans it took, sums bit for bit.
+    let grid = odo.grid();
+    assert_eq!(grid.len(), expected.len());
+    for key in expected.keys() {
+        assert_eq!(grid.stats(key), expected.stats(key), "{key:?}");
+    }
+    // The mapper took the other added scans too: its grid has cells the
+    // matching grid lacks.
+    let mapper = odo.mapper();
+    let mapped = mapper.grid();
+    assert!(mapped.keys().any(|k| grid.stats(k).is_none()));
 }
 
 #[test]

@@ -107,7 +107,9 @@ impl PyOdometry {
     #[new]
     #[pyo3(signature = (
         cell_size = 0.02, *, min_range = None, max_range = None, insert_distance = None,
-        insert_angle = None, map_window = None, min_match_ratio = None, bootstrap_insertions = None,
+        insert_angle = None, map_window = None, match_insert_distance = None,
+        match_insert_angle = None, match_map_window = None, min_match_ratio = None,
+        bootstrap_insertions = None,
         rotation_search = None,
         rotation_step = None, prior_gap_distance = None, prior_gap_angle = None,
         expansion = None, sigma_floor = None, shape_cell = None,
@@ -127,6 +129,9 @@ impl PyOdometry {
         insert_distance: Option<f64>,
         insert_angle: Option<f64>,
         map_window: Option<i64>,
+        match_insert_distance: Option<f64>,
+        match_insert_angle: Option<f64>,
+        match_map_window: Option<i64>,
         min_match_ratio: Option<f64>,
         bootstrap_insertions: Option<i64>,
         rotation_search: Option<f64>,
@@ -162,6 +167,10 @@ impl PyOdometry {
             .map(|w| count("map_window", w))
             .transpose()?
             .map_or(d.map_window, |w| w as usize);
+        let match_window = match_map_window
+            .map(|w| count("match_map_window", w))
+            .transpose()?
+            .map_or(d.match_map_window, |w| w as usize);
         let matcher = MatchOptions {
             expansion: expansion.unwrap_or(m.expansion),
             sigma_floor: sigma_floor.unwrap_or(m.sigma_floor),
@@ -194,6 +203,9 @@ impl PyOdometry {
             max_range: max_range.unwrap_or(d.max_range),
             insert_distance: insert_distance.unwrap_or(d.insert_distance),
             insert_angle: insert_angle.unwrap_or(d.insert_angle),
+            match_insert_distance: match_insert_distance.unwrap_or(d.match_insert_distance),
+            match_insert_angle: match_insert_angle.unwrap_or(d.match_insert_angle),
+            match_map_window: match_window,
             map_window: window,
             min_match_ratio: min_match_ratio.unwrap_or(d.min_match_ratio),
             bootstrap_insertions: bootstrap_insertions
@@ -262,6 +274,12 @@ impl PyOdometry {
         self.with(py, Odometry::insertions)
     }
 
+    /// Of those, the scans the matching grid took.
+    #[getter]
+    fn grid_insertions(&self, py: Python<'_>) -> PyResult<u64> {
+        self.with(py, Odometry::grid_insertions)
+    }
+
     /// Cells in the map now.
     fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
         self.with(py, |o| o.grid().len())
@@ -299,6 +317,9 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("insert_distance", c.insert_distance)?;
     out.set_item("insert_angle", c.insert_angle)?;
     out.set_item("map_window", c.map_window)?;
+    out.set_item("match_insert_distance", c.match_insert_distance)?;
+    out.set_item("match_insert_angle", c.match_insert_angle)?;
+    out.set_item("match_map_window", c.match_map_window)?;
     out.set_item("min_match_ratio", c.min_match_ratio)?;
     out.set_item("bootstrap_insertions", c.bootstrap_insertions)?;
     out.set_item("rotation_search", c.rotation_search)?;
