@@ -112,6 +112,7 @@ def test_multi_start_runs_on_every_scan_or_behind_the_gate() -> None:
 
 def test_map_window_bounds_the_map() -> None:
     truth = trajectory(80)
+
     # The map (the mapper's) and the matching grid, each with its window.
     def config(window: int) -> ndtgrid.OdometryConfig:
         return ndtgrid.OdometryConfig(
