@@ -628,6 +628,18 @@ ODOMETRY_CONFIG_CASES = [
     ({"insert_distance": np.nan}, "insert_distance: expected a finite value >= 0, got NaN"),
     ({"insert_angle": -1.0}, "insert_angle: expected a finite value >= 0, got -1"),
     ({"map_window": -1}, "map_window: expected a non-negative integer below 2**32, got -1"),
+    (
+        {"match_insert_distance": -0.5},
+        "match_insert_distance: expected a finite value >= 0, got -0.5",
+    ),
+    (
+        {"match_insert_angle": np.inf},
+        "match_insert_angle: expected a finite value >= 0, got inf",
+    ),
+    (
+        {"match_map_window": -1},
+        "match_map_window: expected a non-negative integer below 2**32, got -1",
+    ),
     ({"min_match_ratio": 1.5}, "min_match_ratio: expected a fraction in [0, 1], got 1.5"),
     ({"min_match_ratio": np.nan}, "min_match_ratio: expected a fraction in [0, 1], got NaN"),
     ({"rotation_search": -0.1}, "rotation_search: expected a finite value >= 0, got -0.1"),

@@ -274,7 +274,7 @@ impl PyOdometry {
         self.with(py, Odometry::insertions)
     }
 
-    /// Of those, the scans the matching grid took.
+    /// Scans the grid the loop matches against took so far.
     #[getter]
     fn grid_insertions(&self, py: Python<'_>) -> PyResult<u64> {
         self.with(py, Odometry::grid_insertions)
