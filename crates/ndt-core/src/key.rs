@@ -6,6 +6,14 @@ use nalgebra::Vector2;
 /// and coarse levels never overflow `i32`.
 pub const MAX_INDEX: i32 = 1 << 30;
 
+/// Whether `|⌊v⌋| < MAX_INDEX` (false for NaN), without a branch.
+#[inline(always)]
+pub(crate) fn floor_in_range(v: f64) -> bool {
+    let lim = f64::from(MAX_INDEX);
+    // ⌊v⌋ > −lim ⇔ v ≥ 1 − lim; ⌊v⌋ < lim ⇔ v < lim; both false for NaN.
+    v >= 1.0 - lim && v < lim
+}
+
 /// `⌊v⌋` as an index, and whether `|⌊v⌋| < MAX_INDEX` (false for NaN; the
 /// index is meaningless then). The same value as `v.floor() as i32`, without
 /// the libm call that CPUs without SSE4.1's `roundsd` (the default x86-64
@@ -13,9 +21,7 @@ pub const MAX_INDEX: i32 = 1 << 30;
 /// can check them all at once.
 #[inline(always)]
 fn floor_index(v: f64) -> (i32, bool) {
-    let lim = f64::from(MAX_INDEX);
-    // ⌊v⌋ > −lim ⇔ v ≥ 1 − lim; ⌊v⌋ < lim ⇔ v < lim; both false for NaN.
-    let ok = v >= 1.0 - lim && v < lim;
+    let ok = floor_in_range(v);
     // Saturating, and exact truncation toward zero when `ok`; the wrapping
     // subtraction keeps a saturated `t` far out of range from overflowing.
     let t = v as i32;

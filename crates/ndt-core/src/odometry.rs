@@ -21,7 +21,6 @@ use std::collections::VecDeque;
 
 use crate::error::{check_bound, check_finite, NdtError, Result};
 use crate::grid::NdtGrid;
-use crate::key::CellKey;
 use crate::mapper::{Mapper, MapperOptions};
 use crate::mapworker::{MapperHost, MapperView};
 use crate::matcher::{levels_up_to, MatchOptions, MatchResult};
@@ -311,23 +310,6 @@ fn moved(last: Option<Pose2>, pose: Pose2, distance: f64, angle: f64) -> bool {
         let d = at.between(pose);
         d.x.hypot(d.y) >= distance || d.theta.abs() >= angle
     })
-}
-
-/// The cells the scan-frame `points` seen from `pose` fall in (cells of
-/// `cell_size` m), each once, in first-touch order; points beyond the
-/// lattice are left out (the mapper's checks refuse such a scan first).
-fn scan_keys(points: &[[f64; 2]], pose: Pose2, cell_size: f64) -> Vec<CellKey> {
-    let inv = 1.0 / cell_size;
-    let sin_cos = pose.theta.sin_cos();
-    let mut seen = rustc_hash::FxHashSet::default();
-    points
-        .iter()
-        .filter_map(|p| {
-            let w = pose.transform_with(sin_cos, nalgebra::Vector2::new(p[0], p[1]));
-            CellKey::of(w, inv)
-        })
-        .filter(|k| seen.insert(*k))
-        .collect()
 }
 
 /// What one [`Odometry::step`] did.
@@ -744,27 +726,22 @@ impl Odometry {
         } else {
             None
         };
-        let staged = if into_grid {
-            Some(self.grid.stage(points, pose)?)
-        } else {
-            None
-        };
-        // The cells this scan touched, each once, in first-touch order (as
-        // the grid's insert returns them).
-        let mut touched = None;
-        if let Some(staged) = staged {
+        // The scan's cells (the same lattice for both maps), checked before
+        // either map changes.
+        let staged = self.grid.stage(points, pose)?;
+        let touched = if into_grid {
             let keys = self.grid.insert_staged(staged);
-            if checked.is_some() {
-                touched = Some(keys.clone());
-            }
+            let touched = checked.is_some().then(|| keys.clone());
             let stale = self.grid_window.record(keys, self.config.match_map_window);
             self.grid.remove_cells(&stale);
             self.last_grid_insert = Some(pose);
-        }
-        let Some(checked) = checked else {
+            touched
+        } else {
+            Some(staged.cells())
+        };
+        let (Some(checked), Some(touched)) = (checked, touched) else {
             return Ok(());
         };
-        let touched = touched.unwrap_or_else(|| scan_keys(points, pose, self.config.cell_size));
         let stale = self.window.record(touched, self.config.map_window);
         self.last_insert = Some(pose);
         // The mapper takes the scan, then loses its stale cells: in line, or

@@ -24,7 +24,7 @@ use nalgebra::Vector2;
 
 use crate::batch::{pass_terms, Chunk, LaneSums, PassTerms, Scan, LANES, SUMS};
 use crate::distributions::{CursorVisitor, DistLookup, Distributions};
-use crate::key::{CellKey, MAX_INDEX};
+use crate::key::{floor_in_range, CellKey};
 use crate::neighbor::nearest_in_rings_counted;
 use crate::score::Order;
 use crate::se2::Pose2;
@@ -247,7 +247,6 @@ fn cell_keys(
     same: &mut [u8],
 ) {
     let [sn, cs, tx, ty, inv] = pose;
-    let lim = f64::from(MAX_INDEX);
     let rows = chunks
         .iter()
         .zip(kept)
@@ -260,7 +259,7 @@ fn cell_keys(
             // eq. (2) as Pose2::transform_with, then CellKey::of.
             let vx = (cs * x - sn * y + tx) * inv;
             let vy = (sn * x + cs * y + ty) * inv;
-            ok[l] = vx >= 1.0 - lim && vx < lim && vy >= 1.0 - lim && vy < lim;
+            ok[l] = floor_in_range(vx) & floor_in_range(vy);
             // ⌊v⌋ without a conversion instruction (they do not vectorise):
             // adding 1.5 · 2⁵² rounds v to the nearest integer, held in the
             // low bits (exact for |v| < 2⁵¹; lanes out of range are not
@@ -388,6 +387,7 @@ mod tests {
     use crate::batch::PairBlock;
     use crate::distributions::DistOptions;
     use crate::grid::NdtGrid;
+    use crate::key::MAX_INDEX;
     use crate::neighbor::nearest_in_rings_with;
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
