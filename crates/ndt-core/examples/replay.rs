@@ -1,8 +1,10 @@
 //! Profiling harness: a log's scans from a dump of `benches/dump_scans.py`.
 //!
-//! `replay <dump> odometry [reps] [inline]`: `Odometry` (default
-//! configuration; `inline`: `background_mapper: false`) over every scan,
-//! `reps` times; prints the time per scan and the last pose.
+//! `replay <dump> odometry [reps] [inline|loop-only]`: `Odometry` (default
+//! configuration; `inline`: `background_mapper: false`; `loop-only`: the
+//! mapper takes the first scan only, so the loop runs without a mapper's
+//! work beside it, with the same poses) over every scan, `reps` times;
+//! prints the time per scan and the last pose.
 //! `replay <dump> matchhash`: the first 3000 scans matched with the default
 //! options against a map that takes every third scan and loses every 17th
 //! cell (in key order) every 50 scans; prints a hash of every pose's and
@@ -63,11 +65,15 @@ fn thread_cpu() -> f64 {
     ticks / 100.0
 }
 
-fn odometry(scans: &[Scan], reps: usize, inline: bool) -> Result<(), Box<dyn Error>> {
-    let config = OdometryConfig {
-        background_mapper: !inline,
+fn odometry(scans: &[Scan], reps: usize, variant: Option<&str>) -> Result<(), Box<dyn Error>> {
+    let mut config = OdometryConfig {
+        background_mapper: variant != Some("inline"),
         ..OdometryConfig::default()
     };
+    if variant == Some("loop-only") {
+        config.insert_distance = 1e9;
+        config.insert_angle = 1e9;
+    }
     for _ in 0..reps {
         let mut odo = Odometry::new(config)?;
         let t = Instant::now();
@@ -185,7 +191,8 @@ fn mapwork(scans: &[Scan], reps: usize) -> Result<(), Box<dyn Error>> {
 
 fn main() -> Result<(), Box<dyn Error>> {
     let args: Vec<String> = std::env::args().collect();
-    let usage = "usage: replay <dump> odometry [reps] [inline] | matchhash | mapwork [reps]";
+    let usage =
+        "usage: replay <dump> odometry [reps] [inline|loop-only] | matchhash | mapwork [reps]";
     let (Some(path), Some(mode)) = (args.get(1), args.get(2)) else {
         return Err(usage.into());
     };
@@ -194,7 +201,11 @@ fn main() -> Result<(), Box<dyn Error>> {
         "odometry" => odometry(
             &scans,
             args.get(3).map_or(Ok(1), |s| s.parse())?,
-            args.get(4).is_some_and(|s| s == "inline"),
+            match args.get(4).map(String::as_str) {
+                None => None,
+                Some(v @ ("inline" | "loop-only")) => Some(v),
+                Some(_) => return Err(usage.into()),
+            },
         ),
         "matchhash" => matchhash(&scans),
         "mapwork" => mapwork(&scans, args.get(3).map_or(Ok(3), |s| s.parse())?),
