@@ -79,11 +79,13 @@ pub fn walk_cells_in(
 /// [`walk_cells_in`] that crosses the blocks `skip` reports empty without
 /// visiting their cells. For a visitor that does nothing and returns `true`
 /// on those cells it is the same walk: the traversal's state after a skipped
-/// block is the one the cell-by-cell walk reaches there, to the bit (the same
-/// sums, formed in the same order), so every cell outside them is visited
-/// with the same distances. The block holding the end point is walked cell
-/// by cell. A beam through free space then costs a few additions per block
-/// instead of a visit per cell (the §V walks, [`crate::filter::confirmation`]).
+/// block is the one the cell-by-cell walk reaches there, to the bit (both
+/// take the distance of an axis's `k`-th boundary crossing as the same
+/// product, `first + k · step`), so every cell outside them is visited with
+/// the same distances. The block holding the end point is walked cell by
+/// cell. A beam through free space then costs a few operations per block
+/// (and one per crossing of the axis it does not leave by) instead of a
+/// visit per cell (the §V walks, [`crate::filter::confirmation`]).
 pub fn walk_cells_in_skipping(
     from: Vector2<f64>,
     to: Vector2<f64>,
@@ -174,11 +176,19 @@ fn walk_until(
             let boundary = f64::from(index) * cell_size;
             (-1, (boundary - origin) / d, -cell_size / d)
         } else {
-            (0, f64::INFINITY, f64::INFINITY)
+            // Never crossed: every crossing at infinity (k · 0 adds 0).
+            (0, f64::INFINITY, 0.0)
         }
     };
-    let (step_x, mut next_x, delta_x) = axis(dir.x, from.x, key.ix);
-    let (step_y, mut next_y, delta_y) = axis(dir.y, from.y, key.iy);
+    let (step_x, first_x, delta_x) = axis(dir.x, from.x, key.ix);
+    let (step_y, first_y, delta_y) = axis(dir.y, from.y, key.iy);
+    // The distance of an axis's crossing `k` (0: the first), as a product,
+    // not a running sum: a block is then crossed in a few operations (see
+    // below), and the cell-by-cell walk takes exactly the same values.
+    let crossing = |first: f64, d: f64, k: i64| first + k as f64 * d;
+    // Crossings passed per axis, and the distance of the next one.
+    let (mut kx, mut ky) = (0i64, 0i64);
+    let (mut next_x, mut next_y) = (first_x, first_y);
     // The exact number of cells is |Δix| + |Δiy| + 1; round-off at a corner
     // may cost one more, never more than that.
     let budget = (i64::from(last.ix) - i64::from(key.ix)).unsigned_abs()
@@ -195,61 +205,59 @@ fn walk_until(
         if let Some(b) = bits {
             if block_of(key, b) != block_of(last, b) && skip.is_empty(key) {
                 // Cross the block as the loop below would, without visits:
-                // `n` steps along an axis leave the block, and the axis whose
-                // last in-block crossing comes first (x on a tie, as below)
-                // is the one the walk leaves by.
+                // the `n`-th crossing along an axis leaves the block, and the
+                // axis whose leaving crossing comes first (x on a tie, as
+                // below) is the one the walk leaves by; the other axis is
+                // crossed wherever the loop would cross it before that.
                 let side = 1i32 << b;
-                let exits = |step: i32, index: i32| -> u64 {
+                let exits = |step: i32, index: i32| -> Option<i64> {
                     let lo = (index >> b) << b;
                     match step {
-                        1 => (lo + side - index) as u64,
-                        -1 => (index - lo + 1) as u64,
-                        _ => u64::MAX,
+                        1 => Some(i64::from(lo + side - index)),
+                        -1 => Some(i64::from(index - lo + 1)),
+                        _ => None,
                     }
                 };
                 let (nx, ny) = (exits(step_x, key.ix), exits(step_y, key.iy));
-                // Distance of the n-th crossing after `start`, summed step by
-                // step as the loop does.
-                let after = |start: f64, d: f64, n: u64| (0..n).fold(start, |v, _| v + d);
                 let by_x = match (nx, ny) {
-                    (u64::MAX, _) => false,
-                    (_, u64::MAX) => true,
-                    _ => after(next_x, delta_x, nx - 1) <= after(next_y, delta_y, ny - 1),
+                    (None, _) => false,
+                    (_, None) => true,
+                    (Some(nx), Some(ny)) => {
+                        crossing(first_x, delta_x, kx + nx - 1)
+                            <= crossing(first_y, delta_y, ky + ny - 1)
+                    }
                 };
-                let (mut x, mut y) = (next_x, next_y);
-                let (mut sx, mut sy) = (0u64, 0u64);
-                if by_x {
-                    let xe = after(next_x, delta_x, nx - 1);
-                    while y < xe {
-                        y += delta_y;
-                        sy += 1;
+                let (kx0, ky0) = (kx, ky);
+                if let (true, Some(nx)) = (by_x, nx) {
+                    kx += nx - 1;
+                    next_x = crossing(first_x, delta_x, kx);
+                    while next_y < next_x {
+                        ky += 1;
+                        next_y = crossing(first_y, delta_y, ky);
                     }
-                    x = xe;
-                    sx = nx - 1;
-                } else {
-                    let ye = after(next_y, delta_y, ny - 1);
-                    while x <= ye {
-                        x += delta_x;
-                        sx += 1;
+                } else if let Some(ny) = ny {
+                    ky += ny - 1;
+                    next_y = crossing(first_y, delta_y, ky);
+                    while next_x <= next_y {
+                        kx += 1;
+                        next_x = crossing(first_x, delta_x, kx);
                     }
-                    y = ye;
-                    sy = ny - 1;
                 }
-                // (x, y): the crossing distances in the block's last cell; its
-                // exit distance, then the step out.
-                t_in = x.min(y).min(length);
+                // The exit distance of the block's last cell, then the step
+                // out.
+                t_in = next_x.min(next_y).min(length);
                 if by_x {
-                    x += delta_x;
-                    sx += 1;
+                    kx += 1;
+                    next_x = crossing(first_x, delta_x, kx);
                 } else {
-                    y += delta_y;
-                    sy += 1;
+                    ky += 1;
+                    next_y = crossing(first_y, delta_y, ky);
                 }
+                // At most a block's side of crossings per axis.
+                let (sx, sy) = (kx - kx0, ky - ky0);
                 key.ix += step_x * sx as i32;
                 key.iy += step_y * sy as i32;
-                next_x = x;
-                next_y = y;
-                walked += sx + sy;
+                walked += (sx + sy) as u64;
                 continue;
             }
         }
@@ -261,10 +269,12 @@ fn walk_until(
         }
         if next_x <= next_y {
             key.ix += step_x;
-            next_x += delta_x;
+            kx += 1;
+            next_x = crossing(first_x, delta_x, kx);
         } else {
             key.iy += step_y;
-            next_y += delta_y;
+            ky += 1;
+            next_y = crossing(first_y, delta_y, ky);
         }
         t_in = t_out;
         walked += 1;
