@@ -369,19 +369,59 @@ const PROBE_DEPTH: usize = 4;
 /// last ancestor asked about, so a walk along a beam through empty space
 /// looks one ancestor up per block of fine cells instead of every fine cell,
 /// and [`crate::filter::raywalk::walk_cells_in_skipping`] crosses the empty
-/// blocks without visiting their cells.
+/// blocks without visiting their cells. It answers the same question on
+/// smaller blocks too ([`OccupancyProbe::may_hold_inner`]), for the walk
+/// through the blocks that are not empty.
 #[derive(Debug)]
 pub struct OccupancyProbe<'a> {
     ancestors: Option<crate::table::Cursor<'a, CellStats>>,
     depth: usize,
     last: Option<(CellKey, bool)>,
+    /// The same on the smaller blocks ([`INNER_PROBE_DEPTH`], fewer levels
+    /// than the blocks; `None` when there is no such level).
+    inner: Option<crate::table::Cursor<'a, CellStats>>,
+    inner_depth: usize,
+    inner_last: Option<(CellKey, bool)>,
 }
+
+/// Levels above the fine one of the smaller blocks [`OccupancyProbe`] also
+/// looks at, inside the blocks of [`PROBE_DEPTH`] that hold cells (4 × 4
+/// fine cells): a beam crossing such a block near a wall skips the parts of
+/// it away from the wall. `replay intel3k odometry 1 inline` (callgrind):
+/// without them 4.880 G instructions (the §V walks visited 4.09 M cells), 1
+/// level up 4.824 G, 2 levels 4.711 G (0.81 M cells visited), 3 levels
+/// 4.764 G; the final maps are the same.
+const INNER_PROBE_DEPTH: usize = 2;
 
 impl OccupancyProbe<'_> {
     /// log2 of the side \[fine cells\] of the blocks [`OccupancyProbe::may_hold`]
     /// answers for as a whole; `None` when it answers `true` for every cell.
     pub fn block_bits(&self) -> Option<u32> {
         self.ancestors.as_ref().map(|_| self.depth as u32)
+    }
+
+    /// log2 of the side \[fine cells\] of the smaller blocks
+    /// [`OccupancyProbe::may_hold_inner`] answers for; `None` when none.
+    pub fn inner_bits(&self) -> Option<u32> {
+        self.inner.as_ref().map(|_| self.inner_depth as u32)
+    }
+
+    /// [`OccupancyProbe::may_hold`] on the smaller blocks: `false` only when
+    /// no fine cell `key` exists.
+    #[inline]
+    pub fn may_hold_inner(&mut self, key: CellKey) -> bool {
+        let Some(cells) = self.inner.as_mut() else {
+            return true;
+        };
+        let at = crate::pyramid::coarse_key(key, self.inner_depth);
+        match self.inner_last {
+            Some((k, found)) if k == at => found,
+            _ => {
+                let found = cells.get(at).is_some();
+                self.inner_last = Some((at, found));
+                found
+            }
+        }
     }
 
     /// `false` only when no fine cell `key` exists; `true` when it may.
@@ -407,12 +447,19 @@ impl NdtGrid {
     /// answers `true` for every cell).
     pub fn occupancy_probe(&self) -> OccupancyProbe<'_> {
         let depth = PROBE_DEPTH.min(self.levels() - 1);
+        let inner_depth = INNER_PROBE_DEPTH.min(depth.saturating_sub(1));
+        let cursor = |d: usize| {
+            (d > 0)
+                .then(|| self.pyramid.level(d).map(|l| l.cells().cursor()))
+                .flatten()
+        };
         OccupancyProbe {
-            ancestors: (depth > 0)
-                .then(|| self.pyramid.level(depth).map(|l| l.cells().cursor()))
-                .flatten(),
+            ancestors: cursor(depth),
             depth,
             last: None,
+            inner: cursor(inner_depth),
+            inner_depth,
+            inner_last: None,
         }
     }
 }

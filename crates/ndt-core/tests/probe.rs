@@ -1,5 +1,6 @@
 //! `NdtGrid::occupancy_probe` never hides an occupied cell and does rule out
-//! empty space, after inserts and removals.
+//! empty space, on its blocks and on its smaller blocks, after inserts and
+//! removals.
 
 use ndt_core::{CellKey, NdtGrid, Pose2};
 use rand::rngs::StdRng;
@@ -17,25 +18,39 @@ fn the_probe_admits_every_occupied_cell_and_rules_out_empty_blocks() {
     keys.sort_unstable();
     grid.remove_cells(&keys[..keys.len() / 3]);
     let mut probe = grid.occupancy_probe();
-    let (mut ruled_out, mut empty) = (0, 0);
+    assert_eq!((probe.block_bits(), probe.inner_bits()), (Some(4), Some(2)));
+    let (mut ruled_out, mut ruled_out_inner, mut empty) = (0, 0, 0);
     for ix in -120..120 {
         for iy in -120..120 {
             let key = CellKey { ix, iy };
-            let may = probe.may_hold(key);
+            let (may, may_inner) = (probe.may_hold(key), probe.may_hold_inner(key));
             if grid.stats(key).is_some() {
-                assert!(may, "{key:?} is occupied");
+                assert!(may && may_inner, "{key:?} is occupied");
             } else {
                 empty += 1;
                 ruled_out += usize::from(!may);
+                ruled_out_inner += usize::from(!may_inner);
             }
         }
     }
-    // Blocks (16 × 16 cells) beyond the ±1 m square are empty.
+    // Blocks (16 × 16 cells) beyond the ±1 m square are empty, and inside
+    // it most of the smaller blocks (4 × 4) of a sparse scatter are too.
     assert!(
         ruled_out * 3 > empty,
         "{ruled_out} of {empty} empty cells ruled out"
     );
+    assert!(
+        ruled_out_inner > ruled_out + (empty - ruled_out) / 2,
+        "{ruled_out_inner} of {empty} empty cells ruled out by the smaller blocks"
+    );
     // A one-level grid has no coarser level to ask: it admits everything.
     let single = NdtGrid::with_levels(0.02, 1).unwrap();
-    assert!(single.occupancy_probe().may_hold(CellKey { ix: 5, iy: 5 }));
+    let mut probe = single.occupancy_probe();
+    assert_eq!((probe.block_bits(), probe.inner_bits()), (None, None));
+    assert!(probe.may_hold(CellKey { ix: 5, iy: 5 }));
+    assert!(probe.may_hold_inner(CellKey { ix: 5, iy: 5 }));
+    // With 3 levels the blocks are 4 × 4 cells and the smaller ones 2 × 2.
+    let three = NdtGrid::with_levels(0.02, 3).unwrap();
+    let probe = three.occupancy_probe();
+    assert_eq!((probe.block_bits(), probe.inner_bits()), (Some(2), Some(1)));
 }

@@ -30,6 +30,15 @@ pub trait EmptyBlocks {
     /// `true` when the block of cell `key` holds no cell the visitor would
     /// act on.
     fn is_empty(&mut self, key: CellKey) -> bool;
+    /// log2 of the side \[cells\] of smaller blocks, looked at inside the
+    /// blocks that are not empty; `None` (the default): none.
+    fn inner_bits(&self) -> Option<u32> {
+        None
+    }
+    /// [`EmptyBlocks::is_empty`] for the smaller blocks.
+    fn inner_is_empty(&mut self, _key: CellKey) -> bool {
+        false
+    }
 }
 
 /// The blocks a grid's pyramid shows empty ([`crate::grid::OccupancyProbe`]).
@@ -39,6 +48,12 @@ impl EmptyBlocks for crate::grid::OccupancyProbe<'_> {
     }
     fn is_empty(&mut self, key: CellKey) -> bool {
         !self.may_hold(key)
+    }
+    fn inner_bits(&self) -> Option<u32> {
+        crate::grid::OccupancyProbe::inner_bits(self)
+    }
+    fn inner_is_empty(&mut self, key: CellKey) -> bool {
+        !self.may_hold_inner(key)
     }
 }
 
@@ -85,7 +100,9 @@ pub fn walk_cells_in(
 /// the same distances. The block holding the end point is walked cell by
 /// cell. A beam through free space then costs a few operations per block
 /// (and one per crossing of the axis it does not leave by) instead of a
-/// visit per cell (the §V walks, [`crate::filter::confirmation`]).
+/// visit per cell (the §V walks, [`crate::filter::confirmation`]); inside a
+/// block that is not empty, the smaller empty blocks of
+/// [`EmptyBlocks::inner_bits`] are crossed the same way.
 pub fn walk_cells_in_skipping(
     from: Vector2<f64>,
     to: Vector2<f64>,
@@ -195,6 +212,7 @@ fn walk_until(
         + (i64::from(last.iy) - i64::from(key.iy)).unsigned_abs()
         + 2;
     let bits = skip.block_bits().filter(|&b| b < 31);
+    let inner_bits = skip.inner_bits().filter(|&b| b < 31);
     let block_of = |k: CellKey, b: u32| (k.ix >> b, k.iy >> b);
     let mut t_in = 0.0;
     let mut walked: u64 = 0;
@@ -202,64 +220,71 @@ fn walk_until(
         if t_in > stop {
             return;
         }
-        if let Some(b) = bits {
-            if block_of(key, b) != block_of(last, b) && skip.is_empty(key) {
-                // Cross the block as the loop below would, without visits:
-                // the `n`-th crossing along an axis leaves the block, and the
-                // axis whose leaving crossing comes first (x on a tie, as
-                // below) is the one the walk leaves by; the other axis is
-                // crossed wherever the loop would cross it before that.
-                let side = 1i32 << b;
-                let exits = |step: i32, index: i32| -> Option<i64> {
-                    let lo = (index >> b) << b;
-                    match step {
-                        1 => Some(i64::from(lo + side - index)),
-                        -1 => Some(i64::from(index - lo + 1)),
-                        _ => None,
-                    }
-                };
-                let (nx, ny) = (exits(step_x, key.ix), exits(step_y, key.iy));
-                let by_x = match (nx, ny) {
-                    (None, _) => false,
-                    (_, None) => true,
-                    (Some(nx), Some(ny)) => {
-                        crossing(first_x, delta_x, kx + nx - 1)
-                            <= crossing(first_y, delta_y, ky + ny - 1)
-                    }
-                };
-                let (kx0, ky0) = (kx, ky);
-                if let (true, Some(nx)) = (by_x, nx) {
-                    kx += nx - 1;
-                    next_x = crossing(first_x, delta_x, kx);
-                    while next_y < next_x {
-                        ky += 1;
-                        next_y = crossing(first_y, delta_y, ky);
-                    }
-                } else if let Some(ny) = ny {
-                    ky += ny - 1;
-                    next_y = crossing(first_y, delta_y, ky);
-                    while next_x <= next_y {
-                        kx += 1;
-                        next_x = crossing(first_x, delta_x, kx);
-                    }
+        // The block of `key`, or else its smaller block, when empty (and not
+        // the end point's).
+        let empty = match (bits, inner_bits) {
+            (Some(b), _) if block_of(key, b) != block_of(last, b) && skip.is_empty(key) => Some(b),
+            (_, Some(b)) if block_of(key, b) != block_of(last, b) && skip.inner_is_empty(key) => {
+                Some(b)
+            }
+            _ => None,
+        };
+        if let Some(b) = empty {
+            // Cross the block as the loop below would, without visits:
+            // the `n`-th crossing along an axis leaves the block, and the
+            // axis whose leaving crossing comes first (x on a tie, as
+            // below) is the one the walk leaves by; the other axis is
+            // crossed wherever the loop would cross it before that.
+            let side = 1i32 << b;
+            let exits = |step: i32, index: i32| -> Option<i64> {
+                let lo = (index >> b) << b;
+                match step {
+                    1 => Some(i64::from(lo + side - index)),
+                    -1 => Some(i64::from(index - lo + 1)),
+                    _ => None,
                 }
-                // The exit distance of the block's last cell, then the step
-                // out.
-                t_in = next_x.min(next_y).min(length);
-                if by_x {
-                    kx += 1;
-                    next_x = crossing(first_x, delta_x, kx);
-                } else {
+            };
+            let (nx, ny) = (exits(step_x, key.ix), exits(step_y, key.iy));
+            let by_x = match (nx, ny) {
+                (None, _) => false,
+                (_, None) => true,
+                (Some(nx), Some(ny)) => {
+                    crossing(first_x, delta_x, kx + nx - 1)
+                        <= crossing(first_y, delta_y, ky + ny - 1)
+                }
+            };
+            let (kx0, ky0) = (kx, ky);
+            if let (true, Some(nx)) = (by_x, nx) {
+                kx += nx - 1;
+                next_x = crossing(first_x, delta_x, kx);
+                while next_y < next_x {
                     ky += 1;
                     next_y = crossing(first_y, delta_y, ky);
                 }
-                // At most a block's side of crossings per axis.
-                let (sx, sy) = (kx - kx0, ky - ky0);
-                key.ix += step_x * sx as i32;
-                key.iy += step_y * sy as i32;
-                walked += (sx + sy) as u64;
-                continue;
+            } else if let Some(ny) = ny {
+                ky += ny - 1;
+                next_y = crossing(first_y, delta_y, ky);
+                while next_x <= next_y {
+                    kx += 1;
+                    next_x = crossing(first_x, delta_x, kx);
+                }
             }
+            // The exit distance of the block's last cell, then the step
+            // out.
+            t_in = next_x.min(next_y).min(length);
+            if by_x {
+                kx += 1;
+                next_x = crossing(first_x, delta_x, kx);
+            } else {
+                ky += 1;
+                next_y = crossing(first_y, delta_y, ky);
+            }
+            // At most a block's side of crossings per axis.
+            let (sx, sy) = (kx - kx0, ky - ky0);
+            key.ix += step_x * sx as i32;
+            key.iy += step_y * sy as i32;
+            walked += (sx + sy) as u64;
+            continue;
         }
         let t_out = next_x.min(next_y).min(length);
         // Walk until the end point's own cell, even when the segment only
@@ -415,17 +440,25 @@ mod tests {
         assert_eq!(n, 0);
     }
 
-    /// Blocks of 8 × 8 cells, empty by a fixed pseudo-random rule.
-    struct Oracle(u32);
+    /// Blocks of 8 × 8 cells, and smaller ones of 2 × 2 cells when the
+    /// second rate is not 0, empty by fixed pseudo-random rules (at the
+    /// rates out of 5): the walk must be exact whatever they claim.
+    struct Oracle(u32, u32);
 
     impl Oracle {
-        fn empty(&self, key: CellKey) -> bool {
-            let (bx, by) = (key.ix >> 3, key.iy >> 3);
+        fn rule(bits: u32, key: CellKey, rate: u32) -> bool {
+            let (bx, by) = (key.ix >> bits, key.iy >> bits);
             let h = (bx as u32)
                 .wrapping_mul(0x9E37_79B9)
                 .wrapping_add((by as u32).wrapping_mul(0x85EB_CA6B))
-                .rotate_left(13);
-            h % 5 < self.0
+                .rotate_left(13 + bits);
+            h % 5 < rate
+        }
+        fn empty(&self, key: CellKey) -> bool {
+            Self::rule(3, key, self.0)
+        }
+        fn empty_inner(&self, key: CellKey) -> bool {
+            Self::rule(1, key, self.1)
         }
     }
 
@@ -436,11 +469,17 @@ mod tests {
         fn is_empty(&mut self, key: CellKey) -> bool {
             self.empty(key)
         }
+        fn inner_bits(&self) -> Option<u32> {
+            (self.1 > 0).then_some(1)
+        }
+        fn inner_is_empty(&mut self, key: CellKey) -> bool {
+            self.empty_inner(key)
+        }
     }
 
-    /// Skipping empty blocks visits every other cell in the same order, with
-    /// the same distances to the bit, and stops where the cell-by-cell walk
-    /// stops.
+    /// Skipping empty blocks (and smaller empty blocks inside the others)
+    /// visits every other cell in the same order, with the same distances to
+    /// the bit, and stops where the cell-by-cell walk stops.
     #[test]
     fn skipping_empty_blocks_visits_the_other_cells_exactly() {
         let mut rng = StdRng::seed_from_u64(5);
@@ -448,9 +487,9 @@ mod tests {
         let cell = 0.02;
         let region =
             KeyBounds::of(CellKey { ix: -900, iy: -900 }).including(CellKey { ix: 900, iy: 900 });
-        let mut skipped_any = false;
+        let (mut skipped_any, mut skipped_inner) = (false, false);
         for case in 0..5000u32 {
-            let oracle = Oracle(case / 5 % 5);
+            let oracle = Oracle(case / 5 % 5, case / 25 % 4);
             let mut a = Vector2::new(10.0 * next(), 10.0 * next());
             // Axis-parallel, diagonal and general directions, short and long;
             // from cell centres along slopes ±1, ±2, ±1/2, where crossings of
@@ -482,8 +521,12 @@ mod tests {
                 usize::MAX
             };
             let last = CellKey::of(b, 1.0 / cell).unwrap();
+            let block = |k: &CellKey, bits: u32| (k.ix >> bits, k.iy >> bits);
             let keep = |k: &CellKey| {
-                !oracle.empty(*k) || (k.ix >> 3, k.iy >> 3) == (last.ix >> 3, last.iy >> 3)
+                let outer = oracle.empty(*k) && block(k, 3) != block(&last, 3);
+                let inner =
+                    oracle.1 > 0 && oracle.empty_inner(*k) && block(k, 1) != block(&last, 1);
+                !(outer || inner)
             };
             let run = |skip: &mut dyn FnMut() -> Option<Oracle>| {
                 let mut out = Vec::new();
@@ -505,10 +548,11 @@ mod tests {
                 out
             };
             let want = run(&mut || None);
-            let got = run(&mut || Some(Oracle(case / 5 % 5)));
+            let got = run(&mut || Some(Oracle(oracle.0, oracle.1)));
             assert_eq!(got, want, "case {case}: {a:?} -> {b:?}");
             skipped_any |= case / 5 % 5 > 0 && !want.is_empty();
+            skipped_inner |= oracle.1 > 0 && !want.is_empty();
         }
-        assert!(skipped_any);
+        assert!(skipped_any && skipped_inner);
     }
 }
