@@ -374,59 +374,42 @@ const PROBE_DEPTH: usize = 4;
 /// through the blocks that are not empty.
 #[derive(Debug)]
 pub struct OccupancyProbe<'a> {
+    blocks: BlockProbe<'a>,
+    /// The same on the smaller blocks ([`INNER_PROBE_DEPTH`], fewer levels
+    /// than the blocks).
+    inner: BlockProbe<'a>,
+}
+
+/// One level of an [`OccupancyProbe`]: the ancestors `depth` levels above
+/// the fine cells (`None`: no such level, every cell may hold points), and
+/// the last one asked about.
+#[derive(Debug)]
+struct BlockProbe<'a> {
     ancestors: Option<crate::table::Cursor<'a, CellStats>>,
     depth: usize,
     last: Option<(CellKey, bool)>,
-    /// The same on the smaller blocks ([`INNER_PROBE_DEPTH`], fewer levels
-    /// than the blocks; `None` when there is no such level).
-    inner: Option<crate::table::Cursor<'a, CellStats>>,
-    inner_depth: usize,
-    inner_last: Option<(CellKey, bool)>,
 }
 
-/// Levels above the fine one of the smaller blocks [`OccupancyProbe`] also
-/// looks at, inside the blocks of [`PROBE_DEPTH`] that hold cells (4 × 4
-/// fine cells): a beam crossing such a block near a wall skips the parts of
-/// it away from the wall. `replay intel3k odometry 1 inline` (callgrind):
-/// without them 4.880 G instructions (the §V walks visited 4.09 M cells), 1
-/// level up 4.824 G, 2 levels 4.711 G (0.81 M cells visited), 3 levels
-/// 4.764 G; the final maps are the same.
-const INNER_PROBE_DEPTH: usize = 2;
-
-impl OccupancyProbe<'_> {
-    /// log2 of the side \[fine cells\] of the blocks [`OccupancyProbe::may_hold`]
-    /// answers for as a whole; `None` when it answers `true` for every cell.
-    pub fn block_bits(&self) -> Option<u32> {
-        self.ancestors.as_ref().map(|_| self.depth as u32)
-    }
-
-    /// log2 of the side \[fine cells\] of the smaller blocks
-    /// [`OccupancyProbe::may_hold_inner`] answers for; `None` when none.
-    pub fn inner_bits(&self) -> Option<u32> {
-        self.inner.as_ref().map(|_| self.inner_depth as u32)
-    }
-
-    /// [`OccupancyProbe::may_hold`] on the smaller blocks: `false` only when
-    /// no fine cell `key` exists.
-    #[inline]
-    pub fn may_hold_inner(&mut self, key: CellKey) -> bool {
-        let Some(cells) = self.inner.as_mut() else {
-            return true;
-        };
-        let at = crate::pyramid::coarse_key(key, self.inner_depth);
-        match self.inner_last {
-            Some((k, found)) if k == at => found,
-            _ => {
-                let found = cells.get(at).is_some();
-                self.inner_last = Some((at, found));
-                found
-            }
+impl<'a> BlockProbe<'a> {
+    /// The ancestors `depth` levels above the fine cells of `grid` (none at
+    /// depth 0).
+    fn of(grid: &'a NdtGrid, depth: usize) -> Self {
+        Self {
+            ancestors: (depth > 0)
+                .then(|| grid.pyramid.level(depth).map(|l| l.cells().cursor()))
+                .flatten(),
+            depth,
+            last: None,
         }
     }
 
-    /// `false` only when no fine cell `key` exists; `true` when it may.
+    fn bits(&self) -> Option<u32> {
+        self.ancestors.as_ref().map(|_| self.depth as u32)
+    }
+
+    /// `false` only when no fine cell `key` exists under its ancestor.
     #[inline]
-    pub fn may_hold(&mut self, key: CellKey) -> bool {
+    fn may_hold(&mut self, key: CellKey) -> bool {
         let Some(cells) = self.ancestors.as_mut() else {
             return true;
         };
@@ -442,24 +425,49 @@ impl OccupancyProbe<'_> {
     }
 }
 
+/// Levels above the fine one of the smaller blocks [`OccupancyProbe`] also
+/// looks at, inside the blocks of [`PROBE_DEPTH`] that hold cells (4 × 4
+/// fine cells): a beam crossing such a block near a wall skips the parts of
+/// it away from the wall. `replay intel3k odometry 1 inline` (callgrind):
+/// without them 4.880 G instructions (the §V walks visited 4.09 M cells), 1
+/// level up 4.824 G, 2 levels 4.711 G (0.81 M cells visited), 3 levels
+/// 4.764 G; the final maps are the same.
+const INNER_PROBE_DEPTH: usize = 2;
+
+impl OccupancyProbe<'_> {
+    /// log2 of the side \[fine cells\] of the blocks [`OccupancyProbe::may_hold`]
+    /// answers for as a whole; `None` when it answers `true` for every cell.
+    pub fn block_bits(&self) -> Option<u32> {
+        self.blocks.bits()
+    }
+
+    /// log2 of the side \[fine cells\] of the smaller blocks
+    /// [`OccupancyProbe::may_hold_inner`] answers for; `None` when none.
+    pub fn inner_bits(&self) -> Option<u32> {
+        self.inner.bits()
+    }
+
+    /// `false` only when no fine cell `key` exists; `true` when it may.
+    #[inline]
+    pub fn may_hold(&mut self, key: CellKey) -> bool {
+        self.blocks.may_hold(key)
+    }
+
+    /// [`OccupancyProbe::may_hold`] on the smaller blocks.
+    #[inline]
+    pub fn may_hold_inner(&mut self, key: CellKey) -> bool {
+        self.inner.may_hold(key)
+    }
+}
+
 impl NdtGrid {
     /// An [`OccupancyProbe`] of this grid (with a single-level grid it
     /// answers `true` for every cell).
     pub fn occupancy_probe(&self) -> OccupancyProbe<'_> {
         let depth = PROBE_DEPTH.min(self.levels() - 1);
-        let inner_depth = INNER_PROBE_DEPTH.min(depth.saturating_sub(1));
-        let cursor = |d: usize| {
-            (d > 0)
-                .then(|| self.pyramid.level(d).map(|l| l.cells().cursor()))
-                .flatten()
-        };
         OccupancyProbe {
-            ancestors: cursor(depth),
-            depth,
-            last: None,
-            inner: cursor(inner_depth),
-            inner_depth,
-            inner_last: None,
+            blocks: BlockProbe::of(self, depth),
+            inner: BlockProbe::of(self, INNER_PROBE_DEPTH.min(depth.saturating_sub(1))),
         }
     }
 }
