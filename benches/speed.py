@@ -1595,7 +1595,7 @@ def main() -> int:
     args.sweep_scans = [1, 30, 300] if q else [1, 3, 10, 30, 100, 300, 880]
     args.sweep_copies = [0, 2] if q else [0, 1, 4, 16]
     args.thread_matches = 100 if q else 600
-    args.thread_reps = 2 if q else 7
+    args.thread_reps = 3 if q else 21
     args.memory_copies = [1, 2] if q else [1, 2, 4, 8]
 
     if args.intel_child:

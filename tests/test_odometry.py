@@ -221,8 +221,38 @@ def test_bad_input_is_rejected_and_leaves_the_loop_unchanged() -> None:
         ndtgrid.Odometry(config=ndtgrid.OdometryConfig(rotation_search=0.17, rotation_step=1e-9))
     with pytest.raises(ValueError, match="cell_size"):
         ndtgrid.Odometry(cell_size=0.0)
+    with pytest.raises(
+        ValueError, match=r"^translation_tolerance: expected a finite value > 0, got -1$"
+    ):
+        ndtgrid.Odometry(config=ndtgrid.OdometryConfig(translation_tolerance=-1.0))
+    with pytest.raises(
+        ValueError, match=r"^rotation_tolerance: expected a finite value > 0, got NaN$"
+    ):
+        ndtgrid.Odometry(config=ndtgrid.OdometryConfig(rotation_tolerance=math.nan))
     with pytest.raises(TypeError, match="OdometryConfig"):
         ndtgrid.Odometry(config={"max_range": 3.0})  # type: ignore[arg-type]
+
+
+def test_stopping_tolerances_reach_the_matcher() -> None:
+    # Odometry 1 cm and 0.6 degrees off per scan. With tolerances beyond any Newton step
+    # (and no rotational multi-start) every match stops where it starts, so the poses are
+    # the odometry's; with the defaults the matches correct them.
+    truth = trajectory(25)
+    rng = np.random.default_rng(5)
+    odom = truth + np.cumsum(rng.normal(0.0, [0.01, 0.01, 0.01], truth.shape), axis=0)
+    odom[0] = truth[0]
+    loose = ndtgrid.OdometryConfig(
+        translation_tolerance=100.0, rotation_tolerance=100.0, coarse_rotation_search=0.0
+    )
+    runs = {}
+    for name, config in (("loose", loose), ("default", ndtgrid.OdometryConfig())):
+        odo = ndtgrid.Odometry(config=config)
+        for k, pose in enumerate(truth):
+            odo.step(*polar(pose, seed=k, noise=0.003), odom=odom[k])
+        runs[name] = odo.poses
+    np.testing.assert_allclose(runs["loose"], odom, atol=1e-9)
+    assert errors(runs["loose"], truth)[0] > 0.05
+    assert errors(runs["default"], truth)[0] < 0.01
 
 
 def test_empty_scans_follow_the_prior() -> None:

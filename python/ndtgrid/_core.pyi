@@ -1001,6 +1001,8 @@ class OdometryLoop:
         fuse_minority: bool | None = None,
         search_radius: int | None = None,
         max_iterations: int | None = None,
+        translation_tolerance: float | None = None,
+        rotation_tolerance: float | None = None,
         max_step_cells: float | None = None,
         max_step_rotation: float | None = None,
         levels: int | None = None,

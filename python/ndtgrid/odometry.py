@@ -107,6 +107,14 @@ class OdometryConfig:
         Neighbour-search radius [cells].
     max_iterations : int, default 50
         Newton steps per scan at most.
+    translation_tolerance : float, default 3e-4
+        A match stops when Newton's next step is shorter than this [m] (and turns less
+        than ``rotation_tolerance``) on the fine level; each coarser level scales both
+        by its cell size. :meth:`NdtGrid.match` stops at 1e-4 m; the loop at 0.3 mm,
+        for about a tenth fewer instructions at the same relation errors on the five
+        benchmark logs (BENCHMARK.md, "Speed", session 16).
+    rotation_tolerance : float, default 1e-4
+        The rotation of that test [rad].
     max_step_cells : float, default 2.0
         Largest translation per Newton step [cells].
     max_step_rotation : float, default 0.05
@@ -184,6 +192,8 @@ class OdometryConfig:
     fuse_minority: bool = True
     search_radius: int = 1
     max_iterations: int = 50
+    translation_tolerance: float = 3e-4
+    rotation_tolerance: float = 1e-4
     max_step_cells: float = 2.0
     max_step_rotation: float = 0.05
     levels: int | None = None

@@ -34,6 +34,21 @@ pub const DEFAULT_ROTATION_GATE: f64 = 0.8;
 /// σ floor \[m\] of the loop's matcher (see [`OdometryConfig::matcher`]).
 pub const ODOMETRY_SIGMA_FLOOR: f64 = 0.005;
 
+/// Newton step below which the loop's matches stop on the fine level \[m\]
+/// ([`MatchOptions::translation_tolerance`]; coarser levels scale it by their
+/// cell size, as every match does). A match alone stops at 0.1 mm; the loop
+/// stops at 0.3 mm, far below its 2 cm cells and the 25–45 mm relation
+/// errors of the benchmark logs, and takes about a tenth fewer instructions
+/// (callgrind, first 3000 Intel scans without the mapper: 2.85 G → 2.57 G).
+/// Relation errors on the five benchmark logs with their odometry, 0.1 mm
+/// against 0.3 mm: Intel 0.028 / 0.028 m, ACES 0.040 / 0.040, FR079 0.025 /
+/// 0.025, MIT CSAIL 0.030 / 0.029, MIT Killian 0.042 / 0.044; the loop is
+/// chaotic, and 0.095 or 0.11 mm instead of 0.1 mm already moved ACES and
+/// MIT Killian by 1 mm and their largest errors from 0.21 / 0.52 m to
+/// 0.29–0.32 / 0.51–1.28 m (BENCHMARK.md, "Speed", session 16). 0.5 mm took
+/// ACES past that spread (0.043 ± 0.052 m, largest 0.80 m).
+pub const ODOMETRY_TRANSLATION_TOLERANCE: f64 = 3e-4;
+
 /// Largest coarsest-level cell \[m\] of the loop's matches when
 /// [`MatchOptions::levels`] is `None` (see [`OdometryConfig::matcher`]): 5
 /// levels on 2 cm cells, where a match alone takes 6 (up to
@@ -169,7 +184,9 @@ pub struct OdometryConfig {
     /// [`ODOMETRY_COARSEST_CELL`] (5 levels, 2–32 cm, on 2 cm cells), not
     /// 64 cm as a match alone: from a motion prior the 64 cm stage adds
     /// little, and without odometry it made the benchmark logs' matches
-    /// worse (BENCHMARK.md, "Speed", session 14).
+    /// worse (BENCHMARK.md, "Speed", session 14). Its Newton steps stop at
+    /// [`ODOMETRY_TRANSLATION_TOLERANCE`] (0.3 mm on the fine level), not a
+    /// match's 0.1 mm.
     pub matcher: MatchOptions,
     /// The §V elimination applied to every inserted scan for the map the
     /// loop builds ([`Odometry::mapper`]; on by default: `outlier_filter =
@@ -222,6 +239,7 @@ impl Default for OdometryConfig {
                 sigma_floor: ODOMETRY_SIGMA_FLOOR,
                 shape_cell: 0.0,
                 freeze_ratio: crate::degeneracy::DEGENERACY_RATIO,
+                translation_tolerance: ODOMETRY_TRANSLATION_TOLERANCE,
                 ..MatchOptions::default()
             },
             mapper: MapperOptions {

