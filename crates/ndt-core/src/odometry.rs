@@ -39,14 +39,15 @@ pub const ODOMETRY_SIGMA_FLOOR: f64 = 0.005;
 /// cell size, as every match does). A match alone stops at 0.1 mm; the loop
 /// stops at 0.3 mm, far below its 2 cm cells and the 25–45 mm relation
 /// errors of the benchmark logs, and takes about a tenth fewer instructions
-/// (callgrind, first 3000 Intel scans without the mapper: 2.85 G → 2.57 G).
+/// (callgrind, first 3000 Intel scans without the mapper: 2.85 G → 2.54 G).
 /// Relation errors on the five benchmark logs with their odometry, 0.1 mm
 /// against 0.3 mm: Intel 0.028 / 0.028 m, ACES 0.040 / 0.040, FR079 0.025 /
-/// 0.025, MIT CSAIL 0.030 / 0.029, MIT Killian 0.042 / 0.044; the loop is
-/// chaotic, and 0.095 or 0.11 mm instead of 0.1 mm already moved ACES and
-/// MIT Killian by 1 mm and their largest errors from 0.21 / 0.52 m to
-/// 0.29–0.32 / 0.51–1.28 m (BENCHMARK.md, "Speed", session 16). 0.5 mm took
-/// ACES past that spread (0.043 ± 0.052 m, largest 0.80 m).
+/// 0.025, MIT CSAIL 0.030 / 0.029, MIT Killian 0.042 / 0.044 (largest
+/// errors ACES 0.21 / 0.34 m, MIT Killian 0.52 / 0.88 m). The loop is
+/// chaotic: 0.095, 0.105 or 0.11 mm instead of 0.1 mm already moved ACES and
+/// MIT Killian by up to 1 mm and their largest errors to 0.29–0.32 /
+/// 0.51–1.28 m (BENCHMARK.md, "Speed", session 16). 0.5 mm took ACES past
+/// that spread (0.043 ± 0.052 m, largest 0.80 m).
 pub const ODOMETRY_TRANSLATION_TOLERANCE: f64 = 3e-4;
 
 /// Largest coarsest-level cell \[m\] of the loop's matches when
