@@ -111,8 +111,8 @@ class OdometryConfig:
         A match stops when Newton's next step is shorter than this [m] (and turns less
         than ``rotation_tolerance``) on the fine level; each coarser level scales both
         by its cell size. :meth:`NdtGrid.match` stops at 1e-4 m; the loop at 0.3 mm,
-        for about a tenth fewer instructions at the same relation errors on the five
-        benchmark logs (BENCHMARK.md, "Speed", session 16).
+        for about a tenth fewer instructions, with relation errors on the five benchmark
+        logs within the loop's own run-to-run spread (BENCHMARK.md, "Speed", session 16).
     rotation_tolerance : float, default 1e-4
         The rotation of that test [rad].
     max_step_cells : float, default 2.0
