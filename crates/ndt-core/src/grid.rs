@@ -57,7 +57,8 @@ impl StagedScan {
     /// The cells of the scan's points, each once, in the order of their
     /// first point (the order [`NdtGrid::insert`] returns them in).
     pub(crate) fn cells(&self) -> Vec<CellKey> {
-        let mut seen = rustc_hash::FxHashSet::default();
+        // The key set the pyramid's insert dedups with (crate::scratch).
+        let mut seen = crate::scratch::KeySet::default();
         self.points
             .iter()
             .map(|(k, _)| *k)
