@@ -47,6 +47,9 @@ fn directions_below(h: &Matrix3<f64>, length: f64, ratio: f64) -> Vec<[f64; 3]> 
     // q = (x, y, L θ): H_q = D H D with D = diag(1, 1, 1/L).
     let d = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 1.0 / l));
     let hq = d * h * d;
+    if clearly_constrained(&hq, ratio) {
+        return Vec::new();
+    }
     let eig = SymmetricEigen::new(hq);
     let top = eig.eigenvalues.iter().fold(0.0_f64, |m, v| m.max(*v));
     if top <= 0.0 {
@@ -65,6 +68,21 @@ fn directions_below(h: &Matrix3<f64>, length: f64, ratio: f64) -> Vec<[f64; 3]> 
         }
     }
     out
+}
+
+/// `true` when every eigenvalue of the symmetric `h` is certainly at least
+/// `ratio` times the largest, without an eigen-decomposition: `h − s I` is
+/// positive definite (its leading principal minors positive, Sylvester's
+/// criterion) for `s` a little above `ratio` times the Frobenius norm, which
+/// bounds the largest eigenvalue. Then the smallest eigenvalue exceeds `s`
+/// by more than any rounding of a decomposition, so [`directions_below`]
+/// would find no direction: most scans constrain all three, and this spares
+/// them the iterative decomposition (`false` only says "decompose to know").
+fn clearly_constrained(h: &Matrix3<f64>, ratio: f64) -> bool {
+    let s = ratio * h.norm() * (1.0 + 1e-6);
+    let m = h - Matrix3::from_diagonal_element(s);
+    let minor2 = m[(0, 0)] * m[(1, 1)] - m[(0, 1)] * m[(1, 0)];
+    m[(0, 0)] > 0.0 && minor2 > 0.0 && m.determinant() > 0.0
 }
 
 /// The projection `D (I − Σ uuᵀ) D⁻¹` (with `D = diag(1, 1, 1/L)`) that removes
@@ -87,4 +105,104 @@ pub fn constrained_projector(h: &Matrix3<f64>, length: f64, ratio: f64) -> Matri
         p -= q * q.transpose();
     }
     d * p * d_inv
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    /// [`directions_below`] by the decomposition alone (as it was before the
+    /// [`clearly_constrained`] shortcut).
+    fn by_decomposition(h: &Matrix3<f64>, length: f64, ratio: f64) -> Vec<[f64; 3]> {
+        let d = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 1.0 / length));
+        let eig = SymmetricEigen::new(d * h * d);
+        let top = eig.eigenvalues.iter().fold(0.0_f64, |m, v| m.max(*v));
+        if top <= 0.0 {
+            return vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0 / length]];
+        }
+        (0..3)
+            .filter(|&i| eig.eigenvalues[i] < ratio * top)
+            .map(|i| {
+                let v = eig.eigenvectors.column(i);
+                let big = (0..3)
+                    .max_by(|&a, &b| v[a].abs().total_cmp(&v[b].abs()))
+                    .unwrap();
+                let sign = if v[big] < 0.0 { -1.0 } else { 1.0 };
+                [sign * v[0], sign * v[1], sign * v[2] / length]
+            })
+            .collect()
+    }
+
+    /// A symmetric matrix with eigenvalues `values` in random directions.
+    fn with_eigenvalues(rng: &mut StdRng, values: [f64; 3]) -> Matrix3<f64> {
+        let q = nalgebra::Rotation3::from_euler_angles(
+            rng.random_range(-3.0..3.0),
+            rng.random_range(-1.5..1.5),
+            rng.random_range(-3.0..3.0),
+        );
+        let m =
+            q.matrix() * Matrix3::from_diagonal(&Vector3::from(values)) * q.matrix().transpose();
+        (m + m.transpose()) * 0.5
+    }
+
+    /// The shortcut answers only where the decomposition finds no direction,
+    /// and the directions are bit for bit the decomposition's: eigenvalue
+    /// ratios on both sides of the threshold (and at it), negative and zero
+    /// curvatures, scales from 1e-6 to 1e9.
+    #[test]
+    fn the_shortcut_gives_the_decompositions_directions() {
+        let mut rng = StdRng::seed_from_u64(5);
+        let (mut shortcuts, mut wide) = (0, 0);
+        for case in 0..20_000 {
+            let ratio = [DEGENERACY_RATIO, FREEZE_RATIO][case % 2];
+            let scale = 10f64.powf(rng.random_range(-6.0..9.0));
+            let small = match case % 5 {
+                0 => ratio,
+                1 => -rng.random_range(0.0..1.0),
+                2 => 0.0,
+                _ => 10f64.powf(rng.random_range(-4.0..0.0)),
+            };
+            let values = [
+                scale,
+                scale * rng.random_range(small.max(0.0)..=1.0),
+                scale * small,
+            ];
+            // The eigenvalues are those of the scaled matrix (x, y, L θ).
+            let length = rng.random_range(0.5..20.0);
+            let d_inv = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, length));
+            let h = d_inv * with_eigenvalues(&mut rng, values) * d_inv;
+            let d = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 1.0 / length));
+            let fast = clearly_constrained(&(d * h * d), ratio);
+            let want = by_decomposition(&h, length, ratio);
+            if fast {
+                shortcuts += 1;
+                assert!(want.is_empty(), "case {case}: {values:?} {want:?}");
+            }
+            if small >= 0.5 {
+                wide += 1;
+                assert!(fast, "case {case}: {values:?}");
+            }
+            assert_eq!(directions_below(&h, length, ratio), want, "case {case}");
+        }
+        // Every case whose weakest curvature is at least half the strongest
+        // takes the shortcut (the Frobenius norm is at most √3 times the
+        // strongest, so either ratio of it stays below half), and some
+        // closer ones too.
+        assert!(shortcuts > wide && wide > 300, "{shortcuts} {wide}");
+    }
+
+    /// A corridor-like Hessian (one direction 100 times weaker than the
+    /// others) is not "clearly constrained", and its weak direction is found.
+    #[test]
+    fn a_weak_direction_is_still_found() {
+        let h = Matrix3::from_diagonal(&Vector3::new(1e-2, 1.0, 1.0));
+        assert!(!clearly_constrained(&h, DEGENERACY_RATIO));
+        assert_eq!(unconstrained_directions(&h, 1.0), vec![[1.0, 0.0, 0.0]]);
+        let zero = Matrix3::zeros();
+        assert!(!clearly_constrained(&zero, DEGENERACY_RATIO));
+        assert_eq!(unconstrained_directions(&zero, 2.0).len(), 3);
+    }
 }
