@@ -17,13 +17,8 @@ use crate::key::CellKey;
 use crate::parity::ParityMemo;
 
 /// log2 of the tile side \[cells\].
-const TILE_BITS: i32 = 4;
-/// Tile side \[cells\]: 16 × 16 cells (32 cm tiles on a 2 cm grid). Against
-/// 8 × 8 (session 17, BENCHMARK.md "Speed"): a scan along a wall crosses
-/// into a tile not remembered half as often and 77 % of the 3 × 3 blocks lie
-/// inside one tile (56 %), so the Intel loop ran 2.5 % fewer instructions and
-/// 2–5 % less time, for 14 % more memory per cell (slots a sparse scan does
-/// not fill); 32 × 32 saved as much again but took 37 % more memory.
+const TILE_BITS: i32 = 3;
+/// Tile side \[cells\]: 8 × 8 cells (16 cm tiles on a 2 cm grid).
 pub const TILE: i32 = 1 << TILE_BITS;
 const MASK: i32 = TILE - 1;
 /// No value in this slot.
@@ -403,7 +398,7 @@ impl<'a, T> Cursor<'a, T> {
         'a: 'b,
     {
         const NO_TILE: Tile = [EMPTY; (TILE * TILE) as usize];
-        // Inside its tile (196 of a tile's 256 cells), the block is 3 runs of 3
+        // Inside its tile (36 of a tile's 64 cells), the block is 3 runs of 3
         // slots of that one tile: one tile look-up, fixed offsets. On the
         // Intel log's loop this takes the block from 313 to 250 instructions
         // (BENCHMARK.md, "Speed", session 13).
