@@ -274,12 +274,13 @@ impl MapperHost {
         &self,
         ranges: &[f64],
         angles: &[f64],
+        directions: Option<&[(f64, f64)]>,
         pose: Pose2,
     ) -> Result<CheckedScan> {
         match self {
-            Self::Inline(m) => m.check_scan(ranges, angles, pose),
+            Self::Inline(m) => m.check_scan(ranges, angles, directions, pose),
             Self::Behind(b) => {
-                let scan = b.checker.check_scan(ranges, angles, pose)?;
+                let scan = b.checker.check_scan(ranges, angles, directions, pose)?;
                 b.take_error().map_or(Ok(scan), Err)
             }
         }

@@ -741,7 +741,8 @@ impl Odometry {
         // insertion can fail (the mapper's only failures are its checks and
         // its grid's, on the same beams).
         let checked = if to_map {
-            Some(self.mapper.check_scan(ranges, angles, pose)?)
+            let directions = self.beams.of(angles);
+            Some(self.mapper.check_scan(ranges, angles, directions, pose)?)
         } else {
             None
         };

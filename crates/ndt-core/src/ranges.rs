@@ -114,6 +114,18 @@ impl BeamDirections {
             max_range,
         ))
     }
+
+    /// The kept `(sin a, cos a)` of each of `angles`, if they are the angles
+    /// of the last [`BeamDirections::points`] (bit for bit).
+    pub fn of(&self, angles: &[f64]) -> Option<&[(f64, f64)]> {
+        let same = self.angles.len() == angles.len()
+            && self
+                .angles
+                .iter()
+                .zip(angles)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+        same.then_some(self.directions.as_slice())
+    }
 }
 
 #[cfg(test)]

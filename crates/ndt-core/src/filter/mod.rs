@@ -55,7 +55,21 @@ impl Beam {
         pose: crate::Pose2,
         pose_sin_cos: (f64, f64),
     ) -> Self {
-        let (s, c) = angle.sin_cos();
+        Self::along(index, range, angle, angle.sin_cos(), pose, pose_sin_cos)
+    }
+
+    /// [`Beam::seen_from`] with the beam's own `(sin a, cos a)` given (a
+    /// sensor's beams point the same way scan after scan, so a loop keeps
+    /// them: [`crate::ranges::BeamDirections`]).
+    #[inline]
+    pub fn along(
+        index: usize,
+        range: f64,
+        angle: f64,
+        (s, c): (f64, f64),
+        pose: crate::Pose2,
+        pose_sin_cos: (f64, f64),
+    ) -> Self {
         let local = Vector2::new(range * c, range * s);
         Self {
             index,

@@ -168,9 +168,11 @@ impl Mapper {
         &self,
         ranges: &[f64],
         angles: &[f64],
+        directions: Option<&[(f64, f64)]>,
         pose: Pose2,
     ) -> Result<CheckedScan> {
-        self.filter.check_scan(&self.grid, ranges, angles, pose)
+        self.filter
+            .check_scan(&self.grid, ranges, angles, directions, pose)
     }
 
     /// Adds a scan [`Mapper::check_scan`] passed, on this mapper or on one

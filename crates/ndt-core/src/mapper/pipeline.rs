@@ -54,7 +54,7 @@ impl MapFilter {
         angles: &[f64],
         pose: Pose2,
     ) -> Result<()> {
-        let scan = self.check_scan(grid, ranges, angles, pose)?;
+        let scan = self.check_scan(grid, ranges, angles, None, pose)?;
         self.insert_checked(grid, scan)
     }
 
@@ -206,25 +206,29 @@ impl MapFilter {
     /// scan's valid beams, which [`MapFilter::insert_checked`] then takes
     /// without checking them again (and does not fail on: its only other
     /// failures are the grid's checks of the same points). They depend on
-    /// the options and the grid's cell size alone.
+    /// the options and the grid's cell size alone. `directions`: the beams'
+    /// `(sin a, cos a)`, when the caller keeps them (one per angle; else
+    /// computed here).
     pub(crate) fn check_scan(
         &self,
         grid: &NdtGrid,
         ranges: &[f64],
         angles: &[f64],
+        directions: Option<&[(f64, f64)]>,
         pose: Pose2,
     ) -> Result<CheckedScan> {
-        let beams = self.valid_beams(grid, ranges, angles, pose)?;
+        let beams = self.valid_beams(grid, ranges, angles, directions, pose)?;
         Ok(CheckedScan { beams, pose })
     }
 
     /// The valid beams of a scan, checked: lengths, finite angles and pose,
-    /// cell indices in range.
+    /// cell indices in range (see [`MapFilter::check_scan`]).
     fn valid_beams(
         &self,
         grid: &NdtGrid,
         ranges: &[f64],
         angles: &[f64],
+        directions: Option<&[(f64, f64)]>,
         pose: Pose2,
     ) -> Result<Vec<Beam>> {
         check_beams(ranges, angles)?;
@@ -237,7 +241,10 @@ impl MapFilter {
             if !(r.is_finite() && r > 0.0 && r >= lo && r < hi) {
                 continue;
             }
-            let beam = Beam::seen_from(index, r, a, pose, sin_cos);
+            let beam = match directions.and_then(|d| d.get(index)) {
+                Some(&dir) => Beam::along(index, r, a, dir, pose, sin_cos),
+                None => Beam::seen_from(index, r, a, pose, sin_cos),
+            };
             if CellKey::of(beam.world, inv_cell).is_none() {
                 return Err(NdtError::CellIndexOverflow {
                     what: "ranges",
