@@ -95,13 +95,7 @@ impl BeamDirections {
         max_range: f64,
     ) -> Result<Vec<[f64; 2]>> {
         check_scan_and_limits(ranges, angles, min_range, max_range)?;
-        let same = self.angles.len() == angles.len()
-            && self
-                .angles
-                .iter()
-                .zip(angles)
-                .all(|(a, b)| a.to_bits() == b.to_bits());
-        if !same {
+        if self.of(angles).is_none() {
             self.angles.clear();
             self.angles.extend_from_slice(angles);
             self.directions.clear();

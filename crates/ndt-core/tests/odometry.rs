@@ -4,7 +4,7 @@
 mod common;
 
 use ndt_core::ranges::points_from_ranges;
-use ndt_core::{NdtError, NdtGrid, Odometry, OdometryConfig, Pose2};
+use ndt_core::{Mapper, MapperOptions, NdtError, NdtGrid, Odometry, OdometryConfig, Pose2};
 /// Ranges of a beam fan at `pose` inside the square `[-2, 2]²`.
 fn square_scan(pose: Pose2, beams: usize) -> (Vec<f64>, Vec<f64>) {
     let angles: Vec<f64> = (0..beams)
@@ -193,6 +193,45 @@ fn mapper_behind_the_loop_equals_the_mapper_in_line() {
     assert_eq!(inline.0, behind.0);
     assert_eq!(inline.1, behind.1);
     assert_eq!(inline.2, behind.2);
+}
+
+/// The loop hands its mapper the beams' kept sines and cosines (one per beam
+/// for the whole run) instead of a sine and cosine per beam and scan: the
+/// mapper must be the same, bit for bit, as one fed the same scans at the
+/// loop's poses through `Mapper::insert_scan`, also when the angles change
+/// mid-run (the kept directions are then renewed) and for a scan handed to
+/// the map alone (`update_map`, whose angles the loop has not seen).
+#[test]
+fn the_loops_mapper_equals_a_mapper_fed_the_same_scans() {
+    let config = OdometryConfig {
+        insert_distance: 0.03,
+        ..OdometryConfig::default()
+    };
+    let mut odo = Odometry::new(config).unwrap();
+    let options = MapperOptions {
+        min_range: config.min_range,
+        max_range: config.max_range,
+        ..config.mapper
+    };
+    let mut mapper = Mapper::new(config.cell_size, options).unwrap();
+    for i in 0..24 {
+        let t = f64::from(i);
+        let truth = Pose2::new(0.02 * t, 0.01 * t, 0.01 * t);
+        let beams = if i < 12 { 361 } else { 181 };
+        let (r, a) = square_scan(truth, beams);
+        let step = odo.step(&r, &a, None).unwrap();
+        if step.inserted {
+            mapper.insert_scan(&r, &a, step.pose).unwrap();
+        }
+        if i == 17 {
+            let at = Pose2::new(0.3, 0.1, 0.1);
+            let (r, a) = square_scan(at, 97);
+            odo.update_map(&r, &a, at).unwrap();
+            mapper.insert_scan(&r, &a, at).unwrap();
+        }
+    }
+    assert!(odo.insertions() > 10, "{}", odo.insertions());
+    assert_eq!(odo.mapper().to_bytes().unwrap(), mapper.to_bytes().unwrap());
 }
 
 /// Ranges and angles of a 361-beam, 180° scan of the room of the shared
