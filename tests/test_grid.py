@@ -215,3 +215,24 @@ def test_parallel_match_agrees_with_one_thread() -> None:
     np.testing.assert_array_equal(parallel.pose, again.pose)
     np.testing.assert_allclose(parallel.pose, serial.pose, rtol=0, atol=1e-9)
     np.testing.assert_allclose(parallel.pose, truth, atol=0.01)
+
+
+def test_skip_levels_passes_over_pyramid_levels() -> None:
+    truth = np.array([0.1, 0.0, 0.2])
+    pts = scan(tuple(truth), seed=9)
+    guess = truth + [0.02, -0.015, 0.01]
+    full = room_map().match(pts, guess)
+    skipped = room_map().match(pts, guess, skip_levels=[1, 3])
+    for res in (full, skipped):
+        np.testing.assert_allclose(res.pose, truth, atol=2e-3)
+    assert not np.array_equal(full.pose, skipped.pose)
+    # The coarsest matched level (5 of 6) is matched whatever skip_levels says.
+    top = room_map().match(pts, guess, skip_levels=[5])
+    np.testing.assert_array_equal(top.pose, full.pose)
+    assert ndtgrid.default_match_options()["skip_levels"] is None
+    for bad in ([0], [12], [-1]):
+        with pytest.raises(
+            ValueError,
+            match=rf"^skip_levels: expected pyramid levels between 1 and 11, got {bad[0]}$",
+        ):
+            room_map().match(pts, guess, skip_levels=bad)

@@ -255,6 +255,29 @@ def test_stopping_tolerances_reach_the_matcher() -> None:
     assert errors(runs["default"], truth)[0] < 0.01
 
 
+def test_skipped_levels_reach_the_matcher() -> None:
+    # The loop skips the 4 cm level by default; every level (``skip_levels=()``) gives
+    # other poses, and both correct 1 cm / 0.6 degrees per scan of odometry drift.
+    truth = trajectory(25)
+    rng = np.random.default_rng(5)
+    odom = truth + np.cumsum(rng.normal(0.0, [0.01, 0.01, 0.01], truth.shape), axis=0)
+    odom[0] = truth[0]
+    assert ndtgrid.OdometryConfig().skip_levels == (1,)
+    runs = {}
+    for skip in ((1,), (), (1, 3)):
+        odo = ndtgrid.Odometry(config=ndtgrid.OdometryConfig(skip_levels=skip))
+        assert odo._loop.config()["skip_levels"] == (skip or None)
+        for k, pose in enumerate(truth):
+            odo.step(*polar(pose, seed=k, noise=0.003), odom=odom[k])
+        runs[skip] = odo.poses
+        assert errors(odo.poses, truth)[0] < 0.01, skip
+    assert not np.array_equal(runs[(1,)], runs[()])
+    with pytest.raises(
+        ValueError, match=r"^skip_levels: expected pyramid levels between 1 and 11, got 0$"
+    ):
+        ndtgrid.Odometry(config=ndtgrid.OdometryConfig(skip_levels=(0,)))
+
+
 def test_empty_scans_follow_the_prior() -> None:
     odo = ndtgrid.Odometry()
     angles = np.linspace(-1, 1, 5)

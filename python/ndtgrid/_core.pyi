@@ -165,6 +165,7 @@ class NdtGrid:
         freeze_unconstrained: bool = True,
         freeze_ratio: float = 0.1,
         levels: int | None = None,
+        skip_levels: Sequence[int] | None = None,
         coarse_model: bool = True,
         expansion_phases: Sequence[float] | None = None,
         parallel: bool = False,
@@ -271,6 +272,12 @@ class NdtGrid:
             pose and maximises the summed score of its level and the next
             coarser one (that one as its quadratic model, see
             ``coarse_model``), so the last stage includes the fine cells.
+        skip_levels : sequence of int, optional
+            Pyramid levels (1 to 11) the stages pass over: a skipped level is
+            neither matched on nor prepared, and the stage below it pairs with
+            the next matched coarser level. The coarsest matched level is
+            matched whatever this says. ``None`` (default): every level. The
+            odometry loop skips level 1 (4 cm; :class:`OdometryConfig`).
         coarse_model : bool, default True
             From the second stage on, score the coarser level of the stage by
             its second-order expansion about the stage's start (the same
@@ -1006,6 +1013,7 @@ class OdometryLoop:
         max_step_cells: float | None = None,
         max_step_rotation: float | None = None,
         levels: int | None = None,
+        skip_levels: Sequence[int] | None = None,
         coarse_rotation_search: float | None = None,
         coarse_rotation_gate: float | None = None,
         freeze_unconstrained: bool | None = None,

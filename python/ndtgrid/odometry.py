@@ -125,6 +125,14 @@ class OdometryConfig:
         alone goes up to 0.64 m): from a motion prior the 64 cm stage adds little, and
         without odometry it made the benchmark logs' matches worse (``BENCHMARK.md``,
         "Speed", session 14).
+    skip_levels : tuple of int, default (1,)
+        Pyramid levels the matcher passes over (``NdtGrid.match(skip_levels=...)``;
+        ``()``: every level). The loop skips the 4 cm level: 32, 16, 8 and 2 cm cells,
+        the last stage pairing 2 cm with the 8 cm level's model. That level was a quarter
+        of the distributions the matching grid's updates compute and a quarter of a
+        scan's evaluations: 17 % fewer of the loop's instructions, with relation errors
+        on the five benchmark logs within the loop's own run-to-run spread
+        (``BENCHMARK.md``, "Speed", session 17).
     coarse_rotation_search : float, default 0.15
         The matcher's rotational multi-start on its coarsest level [rad]
         (``NdtGrid.match(rotation_search=...)``); 0 turns it off.
@@ -197,6 +205,7 @@ class OdometryConfig:
     max_step_cells: float = 2.0
     max_step_rotation: float = 0.05
     levels: int | None = None
+    skip_levels: tuple[int, ...] = (1,)
     coarse_rotation_search: float = 0.15
     coarse_rotation_gate: float = 0.8
     freeze_unconstrained: bool = True

@@ -167,6 +167,14 @@ pub struct MatchOptions {
     /// the coarsest cell at most [`AUTO_COARSEST_CELL`] (with 2 cm cells: 6
     /// levels, 2–64 cm; with 20 cm cells: 2 levels).
     pub levels: Option<u32>,
+    /// Pyramid levels the coarse-to-fine stages pass over, as a mask (bit `l`
+    /// for level `l`): a skipped level is neither matched on nor prepared, and
+    /// the stage below it takes the next matched coarser level as its window's
+    /// coarser one. The fine level (bit 0) cannot be skipped; the coarsest
+    /// matched level is matched whatever its bit says (it depends on
+    /// [`MatchOptions::levels`]). 0 (the default): every level. The odometry
+    /// loop skips the 4 cm level ([`crate::odometry::ODOMETRY_SKIP_LEVELS`]).
+    pub skip_levels: u32,
     /// From the second coarse-to-fine stage on, score the coarser level of
     /// the stage's window by its second-order expansion about the stage's
     /// start ([`crate::quadratic`]) instead of every point at every trial
@@ -216,6 +224,7 @@ impl Default for MatchOptions {
             freeze_unconstrained: true,
             freeze_ratio: crate::degeneracy::FREEZE_RATIO,
             levels: None,
+            skip_levels: 0,
             coarse_model: true,
             parallel: false,
         }
@@ -291,6 +300,13 @@ impl MatchOptions {
                 name: "rotation_gate",
                 expected: "a score per point >= 0 (inf = the multi-start always)",
                 value: self.rotation_gate,
+            });
+        }
+        if self.skip_levels & 1 != 0 || self.skip_levels >> crate::pyramid::MAX_LEVELS != 0 {
+            return Err(NdtError::InvalidOption {
+                name: "skip_levels",
+                expected: "a mask of pyramid levels 1 to 11 (the fine level cannot be skipped)",
+                value: f64::from(self.skip_levels),
             });
         }
         if self.search_radius > MAX_SEARCH_RADIUS {
@@ -701,6 +717,11 @@ impl NdtGrid {
         let mut memo = LevelMemo::default();
         let mut pairs = MatchPairs::new(points, None, options);
         for level in (0..levels).rev() {
+            // A skipped level between the coarsest and the fine one: the
+            // stages around it pair with each other instead.
+            if level != 0 && level + 1 != levels && options.skip_levels >> level & 1 == 1 {
+                continue;
+            }
             let Some(dists) = self.distributions(level, options.dist_options()) else {
                 break;
             };

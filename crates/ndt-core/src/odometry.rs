@@ -50,6 +50,24 @@ pub const ODOMETRY_SIGMA_FLOOR: f64 = 0.005;
 /// that spread (0.043 ± 0.052 m, largest 0.80 m).
 pub const ODOMETRY_TRANSLATION_TOLERANCE: f64 = 3e-4;
 
+/// Pyramid levels the loop's matches pass over ([`MatchOptions::skip_levels`]):
+/// the 4 cm level. The loop then matches on 32, 16, 8 and 2 cm cells, the
+/// final stage pairing the 2 cm cells with the 8 cm level's model. The 4 cm
+/// level was 26 % of the distributions the matching grid's updates compute
+/// and 3.4 of the 13.2 evaluations of a scan: the loop's own instructions,
+/// first 3000 Intel scans, 2.49 → 2.06 G without the mapper (−17 %). Relation
+/// errors on the five benchmark logs with their odometry stayed within the
+/// loop's own run-to-run spread (fine-level tolerances 0.28–0.32 mm: Intel
+/// 0.028–0.029 m, ACES 0.039–0.045 m against 0.040–0.046 m with every level,
+/// FR079 0.025, MIT CSAIL 0.029, MIT Killian 0.042–0.044 against 0.042–0.044
+/// m; the largest errors in the same ranges), and without odometry ACES and
+/// MIT Killian did better, MIT CSAIL 3 mm worse (BENCHMARK.md, "Speed",
+/// session 17). Skipping 16 cm instead kept the errors too but saves less;
+/// skipping 8 cm (ACES 0.042 ± 0.044 m, largest 0.63 m) or 4 and 16 cm
+/// together (ACES largest 0.96 m, MIT Killian 1.79 m) did worse in single
+/// runs and was not pursued.
+pub const ODOMETRY_SKIP_LEVELS: u32 = 1 << 1;
+
 /// Largest coarsest-level cell \[m\] of the loop's matches when
 /// [`MatchOptions::levels`] is `None` (see [`OdometryConfig::matcher`]): 5
 /// levels on 2 cm cells, where a match alone takes 6 (up to
@@ -185,7 +203,8 @@ pub struct OdometryConfig {
     /// [`ODOMETRY_COARSEST_CELL`] (5 levels, 2–32 cm, on 2 cm cells), not
     /// 64 cm as a match alone: from a motion prior the 64 cm stage adds
     /// little, and without odometry it made the benchmark logs' matches
-    /// worse (BENCHMARK.md, "Speed", session 14). Its Newton steps stop at
+    /// worse (BENCHMARK.md, "Speed", session 14), and of those it passes
+    /// over the 4 cm level ([`ODOMETRY_SKIP_LEVELS`]). Its Newton steps stop at
     /// [`ODOMETRY_TRANSLATION_TOLERANCE`] (0.3 mm on the fine level), not a
     /// match's 0.1 mm.
     pub matcher: MatchOptions,
@@ -241,6 +260,7 @@ impl Default for OdometryConfig {
                 shape_cell: 0.0,
                 freeze_ratio: crate::degeneracy::DEGENERACY_RATIO,
                 translation_tolerance: ODOMETRY_TRANSLATION_TOLERANCE,
+                skip_levels: ODOMETRY_SKIP_LEVELS,
                 ..MatchOptions::default()
             },
             mapper: MapperOptions {

@@ -275,6 +275,7 @@ proptest! {
         search_radius in prop_oneof![0..4u32, Just(1000u32), Just(1001u32)].boxed(),
         max_iterations in prop_oneof![0..60u32, Just(200u32)].boxed(),
         levels in prop_oneof![Just(None), (0..9u32).prop_map(Some)].boxed(),
+        skip_levels in prop_oneof![Just(0u32), 0..64u32, Just(1u32 << 12)].boxed(),
         flags in any::<[bool; 6]>(),
     ) {
         let grid = room_grid();
@@ -296,6 +297,7 @@ proptest! {
             freeze_unconstrained: flags[3],
             freeze_ratio,
             levels,
+            skip_levels,
             coarse_model: flags[5],
             parallel: flags[4],
         };
@@ -448,6 +450,7 @@ fn a_subnormal_expansion_gives_a_finite_score() {
         freeze_unconstrained: false,
         freeze_ratio: 0.1,
         levels: None,
+        skip_levels: 0,
         coarse_model: true,
         parallel: false,
     };

@@ -183,3 +183,54 @@ fn the_rotation_gate_skips_the_multi_start_only_when_the_first_stage_explains_th
         (always.pose, always.iterations)
     );
 }
+
+/// `skip_levels` (the odometry loop's way of passing over the 4 cm level):
+/// a match that skips middle levels still recovers the scan, never builds
+/// the skipped levels' distributions, and differs from the full match; the
+/// coarsest matched level is matched whatever its bit says; the fine level
+/// cannot be skipped.
+#[test]
+fn skipped_levels_are_passed_over() {
+    let with_skip = |skip_levels: u32| MatchOptions {
+        skip_levels,
+        ..MatchOptions::default()
+    };
+    recover(0.02, 0.05, 1.5, 7, &with_skip(1 << 1));
+    recover(0.02, 0.05, 1.5, 8, &with_skip(1 << 1 | 1 << 3));
+    let walls = common::room();
+    let truth = Pose2::new(0.12, -0.08, 0.2);
+    let scan = common::urg_scan(&walls, truth, 0.0, 99);
+    let guess = Pose2::new(0.15, -0.1, 0.22);
+    let run = |options: &MatchOptions| {
+        let grid = dense_map(0.02);
+        let res = grid.match_scan(&scan, guess, options).unwrap();
+        (res, grid.heap_bytes())
+    };
+    let (full, full_bytes) = run(&MatchOptions::default());
+    let (skipped, skipped_bytes) = run(&with_skip(1 << 1));
+    assert_ne!(full.pose, skipped.pose);
+    // One level's distributions fewer (a 64-byte one per 4 cm cell at least).
+    let fours = dense_map(0.02).level(1).map_or(0, |l| l.cells().len());
+    assert!(
+        full_bytes >= skipped_bytes + 64 * fours,
+        "{full_bytes} {skipped_bytes} {fours}"
+    );
+    // The default match has 6 levels: bit 5 (the coarsest) changes nothing.
+    let (top, _) = run(&with_skip(1 << 5));
+    assert_eq!(
+        (top.pose, top.score, top.iterations),
+        (full.pose, full.score, full.iterations)
+    );
+    for bad in [1, 1 << 12] {
+        let err = dense_map(0.02)
+            .match_scan(&scan, guess, &with_skip(bad))
+            .unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            format!(
+                "skip_levels: expected a mask of pyramid levels 1 to 11 \
+                 (the fine level cannot be skipped), got {bad}"
+            )
+        );
+    }
+}

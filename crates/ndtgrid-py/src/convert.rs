@@ -166,6 +166,27 @@ pub fn mat3<'py>(py: Python<'py>, m: [[f64; 3]; 3]) -> PyResult<Bound<'py, PyArr
     PyArray1::from_slice(py, m.as_flattened()).reshape([3, 3])
 }
 
+/// Pyramid levels named by number (option `what`, e.g. `skip_levels`) as a
+/// mask, bit `l` for level `l`: each between 1 and the pyramid's last.
+pub fn level_mask(what: &str, levels: &[i64]) -> PyResult<u32> {
+    let last = ndt_core::pyramid::MAX_LEVELS as i64 - 1;
+    levels.iter().try_fold(0u32, |mask, &l| {
+        if (1..=last).contains(&l) {
+            Ok(mask | 1 << l)
+        } else {
+            Err(PyValueError::new_err(format!(
+                "{what}: expected pyramid levels between 1 and {last}, got {l}"
+            )))
+        }
+    })
+}
+
+/// The levels of a mask of [`level_mask`], in increasing order (`None` for
+/// none).
+pub fn mask_levels(mask: u32) -> Option<Vec<u32>> {
+    (mask != 0).then(|| (0..32).filter(|l| mask >> l & 1 == 1).collect())
+}
+
 /// A non-negative integer option named `what`.
 pub fn count(what: &str, value: i64) -> PyResult<u32> {
     u32::try_from(value).map_err(|_| {

@@ -11,9 +11,9 @@ use std::sync::{Arc, RwLock};
 use ndt_core::{MatchOptions, NdtGrid, Pose2};
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::{PyBytes, PyDict, PyType};
+use pyo3::types::{PyBytes, PyDict, PyTuple, PyType};
 
-use crate::convert::{count, mat3, points, pose, rows, vec3};
+use crate::convert::{count, level_mask, mask_levels, mat3, points, pose, rows, vec3};
 use crate::errors::{poisoned, to_py};
 use crate::result::PyMatchResult;
 
@@ -124,6 +124,7 @@ impl PyNdtGrid {
         pair_neighbors = false, search_radius = 1, max_iterations = 50, translation_tolerance = 1e-4,
         rotation_tolerance = 1e-4, max_step_cells = 2.0, max_step_rotation = 0.05, rotation_search = 0.15, rotation_gate = 0.9, freeze_unconstrained = true, freeze_ratio = 0.1,
         levels = None,
+        skip_levels = None,
         coarse_model = true,
         expansion_phases = None,
         parallel = false
@@ -151,6 +152,7 @@ impl PyNdtGrid {
         freeze_unconstrained: bool,
         freeze_ratio: f64,
         levels: Option<i64>,
+        skip_levels: Option<Vec<i64>>,
         coarse_model: bool,
         expansion_phases: Option<Vec<f64>>,
         parallel: bool,
@@ -173,6 +175,7 @@ impl PyNdtGrid {
             freeze_unconstrained,
             freeze_ratio,
             levels: levels.map(|l| count("levels", l)).transpose()?,
+            skip_levels: level_mask("skip_levels", skip_levels.as_deref().unwrap_or_default())?,
             coarse_model,
             parallel,
         };
@@ -354,6 +357,12 @@ pub fn preset_match_options<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<
     }
 }
 
+/// A mask of skipped pyramid levels as `match`'s `skip_levels` (a tuple of
+/// levels; `None` for none).
+pub(crate) fn level_tuple(py: Python<'_>, mask: u32) -> PyResult<Option<Bound<'_, PyTuple>>> {
+    mask_levels(mask).map(|v| PyTuple::new(py, v)).transpose()
+}
+
 /// `MatchOptions` as `match` keyword arguments.
 fn options_dict<'py>(py: Python<'py>, d: &MatchOptions) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
@@ -374,6 +383,7 @@ fn options_dict<'py>(py: Python<'py>, d: &MatchOptions) -> PyResult<Bound<'py, P
     out.set_item("freeze_unconstrained", d.freeze_unconstrained)?;
     out.set_item("freeze_ratio", d.freeze_ratio)?;
     out.set_item("levels", d.levels)?;
+    out.set_item("skip_levels", level_tuple(py, d.skip_levels)?)?;
     out.set_item("coarse_model", d.coarse_model)?;
     out.set_item("expansion_phases", py.None())?;
     out.set_item("parallel", d.parallel)?;

@@ -9,9 +9,9 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{count, pose, vec3, vector};
+use crate::convert::{count, level_mask, pose, vec3, vector};
 use crate::errors::{poisoned, to_py};
-use crate::grid::PyNdtGrid;
+use crate::grid::{level_tuple, PyNdtGrid};
 
 /// The scan-to-map odometry loop (see the stub for the documentation).
 #[pyclass(name = "OdometryLoop", module = "ndtgrid._core", frozen)]
@@ -116,7 +116,7 @@ impl PyOdometry {
         neighbor_search = None, fuse_minority = None, search_radius = None,
         max_iterations = None, translation_tolerance = None, rotation_tolerance = None,
         max_step_cells = None, max_step_rotation = None,
-        levels = None, coarse_rotation_search = None, coarse_rotation_gate = None,
+        levels = None, skip_levels = None, coarse_rotation_search = None, coarse_rotation_gate = None,
         freeze_unconstrained = None, freeze_ratio = None, coarse_model = None,
         outlier_filter = None, edge_removal = None, backshift_rejection = None,
         observation_check = None, radial_confirmation = None, match_filtered_map = None,
@@ -151,6 +151,7 @@ impl PyOdometry {
         max_step_cells: Option<f64>,
         max_step_rotation: Option<f64>,
         levels: Option<i64>,
+        skip_levels: Option<Vec<i64>>,
         coarse_rotation_search: Option<f64>,
         coarse_rotation_gate: Option<f64>,
         freeze_unconstrained: Option<bool>,
@@ -195,6 +196,10 @@ impl PyOdometry {
             levels: match levels {
                 Some(l) => Some(count("levels", l)?),
                 None => m.levels,
+            },
+            skip_levels: match skip_levels {
+                Some(l) => level_mask("skip_levels", &l)?,
+                None => m.skip_levels,
             },
             rotation_search: coarse_rotation_search.unwrap_or(m.rotation_search),
             freeze_unconstrained: freeze_unconstrained.unwrap_or(m.freeze_unconstrained),
@@ -343,6 +348,7 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("max_step_cells", c.matcher.max_step_cells)?;
     out.set_item("max_step_rotation", c.matcher.max_step_rotation)?;
     out.set_item("levels", c.matcher.levels)?;
+    out.set_item("skip_levels", level_tuple(py, c.matcher.skip_levels)?)?;
     out.set_item("coarse_rotation_search", c.matcher.rotation_search)?;
     out.set_item("coarse_rotation_gate", c.coarse_rotation_gate)?;
     out.set_item("freeze_unconstrained", c.matcher.freeze_unconstrained)?;
