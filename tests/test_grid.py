@@ -220,7 +220,7 @@ def test_parallel_match_agrees_with_one_thread() -> None:
 def test_skip_levels_passes_over_pyramid_levels() -> None:
     truth = np.array([0.1, 0.0, 0.2])
     pts = scan(tuple(truth), seed=9)
-    guess = truth + [0.02, -0.015, 0.01]
+    guess = truth + np.array([0.02, -0.015, 0.01])
     full = room_map().match(pts, guess)
     skipped = room_map().match(pts, guess, skip_levels=[1, 3])
     for res in (full, skipped):
