@@ -33,7 +33,8 @@ from ndtgrid.io import read_benchmark_index, read_benchmark_split
 
 def setting(text: str) -> dict[str, Any]:
     """``"name=value name=value"`` as ``OdometryConfig`` keyword arguments (integers,
-    floats, ``inf``, ``None``, ``true``/``false``); checked by building a loop with them."""
+    floats, ``inf``, ``None``, ``true``/``false``, tuples of integers such as ``()`` or
+    ``(1,3)``); checked by building a loop with them."""
     kwargs: dict[str, Any] = {}
     for item in text.split():
         name, sep, value = item.partition("=")
@@ -43,6 +44,11 @@ def setting(text: str) -> dict[str, Any]:
         parsed: Any
         if low in ("none", "true", "false"):
             parsed = {"none": None, "true": True, "false": False}[low]
+        elif value.startswith("("):
+            try:
+                parsed = tuple(int(v) for v in value.strip("()").split(",") if v)
+            except ValueError as e:
+                raise argparse.ArgumentTypeError(f"{item!r}: not a tuple of integers") from e
         else:
             try:
                 parsed = int(value)
