@@ -68,8 +68,10 @@ class OdometryConfig:
         even below ``min_match_ratio`` (0: never). A map of one sparse scan leaves most
         points without a distribution even at the right pose (1-degree SICK beams on 2 cm
         cells), and without odometry the loop would then never move far enough to insert
-        a second scan: ACES without odometry stayed at the origin with 0 and tracked with
-        2 (``BENCHMARK.md``).
+        a second scan: matching on every level (``skip_levels=()``), ACES without odometry
+        stayed at the origin with 0 and tracked with 2 (``BENCHMARK.md``). With the 4 cm
+        level passed over (the default) its first match is accepted anyway, and 0 and 2
+        give the same run; the rule stays for maps that need it.
     rotation_search : float, default 0 (off)
         Before matching, the score of eq. (1) is evaluated at the prediction turned by
         ``+-rotation_step, +-2 rotation_step, ...`` up to this [rad], and Newton starts from

@@ -143,7 +143,11 @@ pub struct OdometryConfig {
     /// without odometry stayed at the origin (0.736 m relation error) with
     /// 0, and tracked (0.072 m) with 2. With odometry the five benchmark
     /// logs gave the same relation errors, ACES 0.039 against 0.040 m
-    /// (BENCHMARK.md, "Speed", session 9).
+    /// (BENCHMARK.md, "Speed", session 9). Since the loop passes over the
+    /// 4 cm level ([`ODOMETRY_SKIP_LEVELS`]), ACES's first match without
+    /// odometry is accepted anyway and 0 and 2 give the same run (0.057 m);
+    /// matching on every level, 0 still leaves it at the origin (session 17).
+    /// The rule stays for maps that need it.
     pub bootstrap_insertions: usize,
     /// Half-width of the search over the predicted rotation before matching
     /// \[rad\] (0 = off): the score of eq. (1) is evaluated at the prediction

@@ -348,10 +348,15 @@ fn hall_scan(pose: Pose2, seed: u64) -> (Vec<f64>, Vec<f64>) {
 
 #[test]
 fn a_young_sparse_map_accepts_converged_matches_so_the_loop_starts() {
-    let run = |bootstrap_insertions: usize| {
+    let run = |bootstrap_insertions: usize, skip_levels: u32| {
+        let d = OdometryConfig::default();
         let config = OdometryConfig {
             bootstrap_insertions,
-            ..OdometryConfig::default()
+            matcher: ndt_core::MatchOptions {
+                skip_levels,
+                ..d.matcher
+            },
+            ..d
         };
         let mut odo = Odometry::new(config).unwrap();
         let mut worst: f64 = 0.0;
@@ -364,12 +369,17 @@ fn a_young_sparse_map_accepts_converged_matches_so_the_loop_starts() {
         }
         (worst, odo.insertions())
     };
-    // Without the rule the first match is refused, the pose stays at the
-    // origin and no second scan is ever inserted.
-    let (stuck_error, stuck_insertions) = run(0);
+    // Matching on every level, without the rule the first match is refused,
+    // the pose stays at the origin and no second scan is ever inserted.
+    let (stuck_error, stuck_insertions) = run(0, 0);
     assert_eq!(stuck_insertions, 1);
     assert!(stuck_error > 1.0, "{stuck_error}");
-    let (error, insertions) = run(2);
-    assert!(insertions >= 10, "{insertions}");
-    assert!(error < 0.02, "{error}");
+    // With the rule, and with the loop's default levels (the 4 cm one passed
+    // over, whose first match is accepted without it here), the loop starts.
+    let skip = OdometryConfig::default().matcher.skip_levels;
+    for (bootstrap, skip_levels) in [(2, 0), (2, skip), (0, skip)] {
+        let (error, insertions) = run(bootstrap, skip_levels);
+        assert!(insertions >= 10, "{insertions}");
+        assert!(error < 0.02, "{error}");
+    }
 }
