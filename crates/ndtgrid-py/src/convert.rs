@@ -9,7 +9,7 @@ use numpy::{
 };
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyAnyMethods;
+use pyo3::types::{PyAnyMethods, PyTuple};
 
 /// `(N, 2)` float64 points, borrowed from a C-contiguous numpy array.
 pub struct Points<'py> {
@@ -181,10 +181,13 @@ pub fn level_mask(what: &str, levels: &[i64]) -> PyResult<u32> {
     })
 }
 
-/// The levels of a mask of [`level_mask`], in increasing order (`None` for
-/// none).
-pub fn mask_levels(mask: u32) -> Option<Vec<u32>> {
-    (mask != 0).then(|| (0..32).filter(|l| mask >> l & 1 == 1).collect())
+/// A mask of [`level_mask`] as `match`'s `skip_levels`: a tuple of the
+/// levels in increasing order, `None` for none.
+pub fn level_tuple(py: Python<'_>, mask: u32) -> PyResult<Option<Bound<'_, PyTuple>>> {
+    if mask == 0 {
+        return Ok(None);
+    }
+    PyTuple::new(py, (0..32u32).filter(|l| mask >> l & 1 == 1)).map(Some)
 }
 
 /// A non-negative integer option named `what`.

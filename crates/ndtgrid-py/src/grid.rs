@@ -11,9 +11,9 @@ use std::sync::{Arc, RwLock};
 use ndt_core::{MatchOptions, NdtGrid, Pose2};
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::{PyBytes, PyDict, PyTuple, PyType};
+use pyo3::types::{PyBytes, PyDict, PyType};
 
-use crate::convert::{count, level_mask, mask_levels, mat3, points, pose, rows, vec3};
+use crate::convert::{count, level_mask, level_tuple, mat3, points, pose, rows, vec3};
 use crate::errors::{poisoned, to_py};
 use crate::result::PyMatchResult;
 
@@ -355,12 +355,6 @@ pub fn preset_match_options<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<
             "name: expected 'paper' or 'original_ndt', got {name:?}"
         ))),
     }
-}
-
-/// A mask of skipped pyramid levels as `match`'s `skip_levels` (a tuple of
-/// levels; `None` for none).
-pub(crate) fn level_tuple(py: Python<'_>, mask: u32) -> PyResult<Option<Bound<'_, PyTuple>>> {
-    mask_levels(mask).map(|v| PyTuple::new(py, v)).transpose()
 }
 
 /// `MatchOptions` as `match` keyword arguments.

@@ -9,9 +9,9 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{count, level_mask, pose, vec3, vector};
+use crate::convert::{count, level_mask, level_tuple, pose, vec3, vector};
 use crate::errors::{poisoned, to_py};
-use crate::grid::{level_tuple, PyNdtGrid};
+use crate::grid::PyNdtGrid;
 
 /// The scan-to-map odometry loop (see the stub for the documentation).
 #[pyclass(name = "OdometryLoop", module = "ndtgrid._core", frozen)]
