@@ -187,7 +187,8 @@ pub fn level_tuple(py: Python<'_>, mask: u32) -> PyResult<Option<Bound<'_, PyTup
     if mask == 0 {
         return Ok(None);
     }
-    PyTuple::new(py, (0..32u32).filter(|l| mask >> l & 1 == 1)).map(Some)
+    let levels: Vec<u32> = (0..32).filter(|l| mask >> l & 1 == 1).collect();
+    PyTuple::new(py, levels).map(Some)
 }
 
 /// A non-negative integer option named `what`.
