@@ -233,14 +233,21 @@ def test_bad_input_is_rejected_and_leaves_the_loop_unchanged() -> None:
         ndtgrid.Odometry(config={"max_range": 3.0})  # type: ignore[arg-type]
 
 
+def drifting_odometry(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` poses of :func:`trajectory` and an odometry of them drifting by 1 cm and
+    0.6 degrees (one sigma) per scan, from the same first pose."""
+    truth = trajectory(n)
+    rng = np.random.default_rng(5)
+    odom = truth + np.cumsum(rng.normal(0.0, [0.01, 0.01, 0.01], truth.shape), axis=0)
+    odom[0] = truth[0]
+    return truth, odom
+
+
 def test_stopping_tolerances_reach_the_matcher() -> None:
     # Odometry 1 cm and 0.6 degrees off per scan. With tolerances beyond any Newton step
     # (and no rotational multi-start) every match stops where it starts, so the poses are
     # the odometry's; with the defaults the matches correct them.
-    truth = trajectory(25)
-    rng = np.random.default_rng(5)
-    odom = truth + np.cumsum(rng.normal(0.0, [0.01, 0.01, 0.01], truth.shape), axis=0)
-    odom[0] = truth[0]
+    truth, odom = drifting_odometry(25)
     loose = ndtgrid.OdometryConfig(
         translation_tolerance=100.0, rotation_tolerance=100.0, coarse_rotation_search=0.0
     )
@@ -258,10 +265,7 @@ def test_stopping_tolerances_reach_the_matcher() -> None:
 def test_skipped_levels_reach_the_matcher() -> None:
     # The loop skips the 4 cm level by default; every level (``skip_levels=()``) gives
     # other poses, and both correct 1 cm / 0.6 degrees per scan of odometry drift.
-    truth = trajectory(25)
-    rng = np.random.default_rng(5)
-    odom = truth + np.cumsum(rng.normal(0.0, [0.01, 0.01, 0.01], truth.shape), axis=0)
-    odom[0] = truth[0]
+    truth, odom = drifting_odometry(25)
     assert ndtgrid.OdometryConfig().skip_levels == (1,)
     runs = {}
     for skip in ((1,), (), (1, 3)):

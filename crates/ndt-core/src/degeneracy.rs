@@ -50,6 +50,12 @@ fn directions_below(h: &Matrix3<f64>, length: f64, ratio: f64) -> Vec<[f64; 3]> 
     if clearly_constrained(&hq, ratio) {
         return Vec::new();
     }
+    decomposed_directions_below(hq, l, ratio)
+}
+
+/// [`directions_below`] of the scaled matrix `hq` (order `x, y, L θ`, lever
+/// arm `l`) by its eigen-decomposition.
+fn decomposed_directions_below(hq: Matrix3<f64>, l: f64, ratio: f64) -> Vec<[f64; 3]> {
     let eig = SymmetricEigen::new(hq);
     let top = eig.eigenvalues.iter().fold(0.0_f64, |m, v| m.max(*v));
     if top <= 0.0 {
@@ -111,42 +117,9 @@ pub fn constrained_projector(h: &Matrix3<f64>, length: f64, ratio: f64) -> Matri
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
+    use crate::testing::random_symmetric;
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
-
-    /// [`directions_below`] by the decomposition alone (as it was before the
-    /// [`clearly_constrained`] shortcut).
-    fn by_decomposition(h: &Matrix3<f64>, length: f64, ratio: f64) -> Vec<[f64; 3]> {
-        let d = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 1.0 / length));
-        let eig = SymmetricEigen::new(d * h * d);
-        let top = eig.eigenvalues.iter().fold(0.0_f64, |m, v| m.max(*v));
-        if top <= 0.0 {
-            return vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0 / length]];
-        }
-        (0..3)
-            .filter(|&i| eig.eigenvalues[i] < ratio * top)
-            .map(|i| {
-                let v = eig.eigenvectors.column(i);
-                let big = (0..3)
-                    .max_by(|&a, &b| v[a].abs().total_cmp(&v[b].abs()))
-                    .unwrap();
-                let sign = if v[big] < 0.0 { -1.0 } else { 1.0 };
-                [sign * v[0], sign * v[1], sign * v[2] / length]
-            })
-            .collect()
-    }
-
-    /// A symmetric matrix with eigenvalues `values` in random directions.
-    fn with_eigenvalues(rng: &mut StdRng, values: [f64; 3]) -> Matrix3<f64> {
-        let q = nalgebra::Rotation3::from_euler_angles(
-            rng.random_range(-3.0..3.0),
-            rng.random_range(-1.5..1.5),
-            rng.random_range(-3.0..3.0),
-        );
-        let m =
-            q.matrix() * Matrix3::from_diagonal(&Vector3::from(values)) * q.matrix().transpose();
-        (m + m.transpose()) * 0.5
-    }
 
     /// The shortcut answers only where the decomposition finds no direction,
     /// and the directions are bit for bit the decomposition's: eigenvalue
@@ -173,10 +146,12 @@ mod tests {
             // The eigenvalues are those of the scaled matrix (x, y, L θ).
             let length = rng.random_range(0.5..20.0);
             let d_inv = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, length));
-            let h = d_inv * with_eigenvalues(&mut rng, values) * d_inv;
+            let h = d_inv * random_symmetric(&mut rng, values) * d_inv;
             let d = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, 1.0 / length));
-            let fast = clearly_constrained(&(d * h * d), ratio);
-            let want = by_decomposition(&h, length, ratio);
+            let hq = d * h * d;
+            let fast = clearly_constrained(&hq, ratio);
+            // The decomposition alone (as before the shortcut).
+            let want = decomposed_directions_below(hq, length, ratio);
             if fast {
                 shortcuts += 1;
                 assert!(want.is_empty(), "case {case}: {values:?} {want:?}");

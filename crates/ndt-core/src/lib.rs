@@ -53,6 +53,8 @@ pub mod shape;
 pub mod shaped;
 pub mod solver;
 pub mod table;
+#[cfg(test)]
+mod testing;
 pub mod window;
 
 pub use cell::{CellStats, Gaussian};

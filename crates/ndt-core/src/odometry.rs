@@ -765,7 +765,9 @@ impl Odometry {
         // insertion can fail (the mapper's only failures are its checks and
         // its grid's, on the same beams).
         let checked = if to_map {
-            let directions = self.beams.of(angles);
+            // Both callers took `points` from these angles just before, so
+            // the kept directions are theirs.
+            let directions = Some(self.beams.directions()).filter(|d| d.len() == angles.len());
             Some(self.mapper.check_scan(ranges, angles, directions, pose)?)
         } else {
             None

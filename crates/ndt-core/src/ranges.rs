@@ -95,7 +95,13 @@ impl BeamDirections {
         max_range: f64,
     ) -> Result<Vec<[f64; 2]>> {
         check_scan_and_limits(ranges, angles, min_range, max_range)?;
-        if self.of(angles).is_none() {
+        let same = self.angles.len() == angles.len()
+            && self
+                .angles
+                .iter()
+                .zip(angles)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+        if !same {
             self.angles.clear();
             self.angles.extend_from_slice(angles);
             self.directions.clear();
@@ -109,16 +115,10 @@ impl BeamDirections {
         ))
     }
 
-    /// The kept `(sin a, cos a)` of each of `angles`, if they are the angles
-    /// of the last [`BeamDirections::points`] (bit for bit).
-    pub fn of(&self, angles: &[f64]) -> Option<&[(f64, f64)]> {
-        let same = self.angles.len() == angles.len()
-            && self
-                .angles
-                .iter()
-                .zip(angles)
-                .all(|(a, b)| a.to_bits() == b.to_bits());
-        same.then_some(self.directions.as_slice())
+    /// The `(sin a, cos a)` of each angle of the last
+    /// [`BeamDirections::points`] call (empty before the first).
+    pub fn directions(&self) -> &[(f64, f64)] {
+        &self.directions
     }
 }
 

@@ -218,6 +218,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testing::random_symmetric;
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
 
@@ -234,18 +235,6 @@ mod tests {
                 col * (col.dot(rhs) / eig.eigenvalues[i].abs().max(floor))
             })
             .sum()
-    }
-
-    fn random_symmetric(rng: &mut StdRng, eigenvalues: [f64; 3]) -> Matrix3<f64> {
-        let q = nalgebra::Rotation3::from_euler_angles(
-            rng.random_range(-3.0..3.0),
-            rng.random_range(-1.5..1.5),
-            rng.random_range(-3.0..3.0),
-        );
-        let m = q.matrix()
-            * Matrix3::from_diagonal(&Vector3::from(eigenvalues))
-            * q.matrix().transpose();
-        (m + m.transpose()) * 0.5
     }
 
     #[test]
