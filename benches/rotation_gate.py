@@ -19,36 +19,15 @@ Run from the repository root::
 from __future__ import annotations
 
 import argparse
-import gc
 import sys
-import time
 from pathlib import Path
-
-import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import speed
-from sigma_floor import parse_with_sets, successes
+from sigma_floor import parse_with_sets, successes, urg_medians
 
 GATES = (float("inf"), 0.95, 0.9, 0.85, 0.8)
 MIN_POINTS = 500  # the issue's dense URG-04LX scans
-
-
-def urg_times(gates: list[float], seed: int) -> dict[float, float]:
-    """Median match time [s] per gate over the URG log's scans of >= MIN_POINTS points:
-    the cases of ``speed.urg_log_maps`` (the same maps and starts as ``speed.py``)."""
-    times: dict[float, list[float]] = {g: [] for g in gates}
-    for k, (grid, points, guess) in enumerate(speed.urg_log_maps(seed, min_points=MIN_POINTS)):
-        # Each scan's matches in a turned order, so no gate always goes first.
-        for i in range(len(gates)):
-            g = gates[(i + k) % len(gates)]
-            gc.disable()
-            t0 = time.perf_counter()
-            grid.match(points, guess, rotation_gate=g)
-            times[g].append(time.perf_counter() - t0)
-            gc.enable()
-    return {g: float(np.median(t)) for g, t in times.items()}
 
 
 def main() -> None:
@@ -57,7 +36,7 @@ def main() -> None:
     ap.add_argument("--gates", nargs="+", type=float, default=list(GATES))
     args, sets, starts = parse_with_sets(ap)
     names = list(sets)
-    medians = urg_times(args.gates, args.seed + 4)
+    medians = urg_medians({g: {"rotation_gate": g} for g in args.gates}, args.seed + 4, MIN_POINTS)
     print(
         "Successes from local / wide starts (of "
         + ", ".join(f"{n} {len(sets[n]) * args.starts}" for n in names)

@@ -12,7 +12,10 @@ Run: ``python benches/sigma_floor.py [--pairs 30] [--starts 8]``; prints a Markd
 from __future__ import annotations
 
 import argparse
+import gc
 import sys
+import time
+from collections.abc import Hashable
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +44,28 @@ def successes(pairs: list[cv.Pair], starts: list[np.ndarray], **options: Any) ->
             et, er = pose_error(pose, pair.truth)
             ok += et < pair.tol[0] and er < pair.tol[1]
     return ok
+
+
+def urg_medians(
+    variants: dict[Hashable, dict[str, Any]], seed: int, min_points: int = 500
+) -> dict[Hashable, float]:
+    """Median match time [s] per variant (its ``match`` options) over the real URG-04LX
+    log's scans of at least ``min_points`` points: the cases of ``speed.urg_log_maps``
+    (the maps and starts of ``benches/speed.py``), every variant on the same cases, each
+    scan's matches in an order turned by one variant from scan to scan."""
+    import speed
+
+    names = list(variants)
+    times: dict[Hashable, list[float]] = {v: [] for v in names}
+    for k, (grid, points, guess) in enumerate(speed.urg_log_maps(seed, min_points=min_points)):
+        for i in range(len(names)):
+            v = names[(i + k) % len(names)]
+            gc.disable()
+            t0 = time.perf_counter()
+            grid.match(points, guess, **variants[v])
+            times[v].append(time.perf_counter() - t0)
+            gc.enable()
+    return {v: float(np.median(t)) for v, t in times.items()}
 
 
 def success(pairs: list[cv.Pair], starts: list[np.ndarray], floor: float) -> float:

@@ -146,15 +146,21 @@ def test_matching_from_four_threads_equals_serial() -> None:
         assert b is not None and np.array_equal(a, b)
 
 
-def _signature_defaults(sig: str) -> dict[str, str]:
-    return dict(re.findall(r"(\w+)=([^,)]+)", sig))
+def _kw_defaults(fn: ast.stmt) -> dict[str, object]:
+    """The keyword-only defaults of a parsed function, as Python values."""
+    assert isinstance(fn, ast.FunctionDef)
+    return {
+        a.arg: ast.literal_eval(d)
+        for a, d in zip(fn.args.kwonlyargs, fn.args.kw_defaults)
+        if d is not None
+    }
 
 
 def test_documented_defaults_are_the_core_defaults() -> None:
     core = ndtgrid.default_match_options()
     text = ndtgrid.NdtGrid.match.__text_signature__
     assert text is not None
-    binding = _signature_defaults(text)
+    binding = _kw_defaults(ast.parse(f"def f{text.replace('$self', 'self')}: pass").body[0])
     stub = Path(ndtgrid.__file__).with_name("_core.pyi").read_text()
     tree = ast.parse(stub)
     fn = next(
@@ -164,18 +170,11 @@ def test_documented_defaults_are_the_core_defaults() -> None:
         for n in c.body
         if isinstance(n, ast.FunctionDef) and n.name == "match"
     )
-    stub_defaults = {
-        a.arg: ast.literal_eval(d)
-        for a, d in zip(fn.args.kwonlyargs, fn.args.kw_defaults)
-        if d is not None
-    }
+    stub_defaults = _kw_defaults(fn)
     assert set(core) == set(stub_defaults) == set(binding)
     for name, value in core.items():
         assert stub_defaults[name] == value, name
-        assert (
-            ast.literal_eval(binding[name].replace("true", "True").replace("false", "False"))
-            == value
-        ), name
+        assert binding[name] == value, name
 
 
 def test_se2_helpers_round_trip() -> None:
@@ -195,7 +194,7 @@ def test_memory_bytes_counts_the_sums_and_the_prepared_distributions() -> None:
     assert sums > empty + 56 * len(grid)
     grid.match(scan((0.1, 0.0, 0.2), seed=9), np.array([0.1, 0.0, 0.2]))
     built = grid.memory_bytes
-    # The distributions of six levels, at least a 64-byte one per fine cell.
+    # The distributions of five levels (4 cm skipped), at least a 64-byte one per fine cell.
     assert built > sums + 64 * len(grid)
     assert built / len(grid) < 2000
     # A second match with the same options adds nothing.
@@ -221,7 +220,7 @@ def test_skip_levels_passes_over_pyramid_levels() -> None:
     truth = np.array([0.1, 0.0, 0.2])
     pts = scan(tuple(truth), seed=9)
     guess = truth + np.array([0.02, -0.015, 0.01])
-    full = room_map().match(pts, guess)
+    full = room_map().match(pts, guess, skip_levels=())
     skipped = room_map().match(pts, guess, skip_levels=[1, 3])
     for res in (full, skipped):
         np.testing.assert_allclose(res.pose, truth, atol=2e-3)
@@ -229,7 +228,11 @@ def test_skip_levels_passes_over_pyramid_levels() -> None:
     # The coarsest matched level (5 of 6) is matched whatever skip_levels says.
     top = room_map().match(pts, guess, skip_levels=[5])
     np.testing.assert_array_equal(top.pose, full.pose)
-    assert ndtgrid.default_match_options()["skip_levels"] is None
+    # The default (``None``) skips 4 cm, as ``skip_levels=[1]`` does.
+    assert ndtgrid.default_match_options()["skip_levels"] == (1,)
+    default = room_map().match(pts, guess)
+    np.testing.assert_array_equal(default.pose, room_map().match(pts, guess, skip_levels=[1]).pose)
+    assert not np.array_equal(default.pose, full.pose)
     for bad in ([0], [12], [-1]):
         with pytest.raises(
             ValueError,

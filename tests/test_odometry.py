@@ -270,7 +270,7 @@ def test_skipped_levels_reach_the_matcher() -> None:
     runs = {}
     for skip in ((1,), (), (1, 3)):
         odo = ndtgrid.Odometry(config=ndtgrid.OdometryConfig(skip_levels=skip))
-        assert odo._loop.config()["skip_levels"] == (skip or None)
+        assert odo._loop.config()["skip_levels"] == skip
         for k, pose in enumerate(truth):
             odo.step(*polar(pose, seed=k, noise=0.003), odom=odom[k])
         runs[skip] = odo.poses

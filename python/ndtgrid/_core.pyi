@@ -165,7 +165,7 @@ class NdtGrid:
         freeze_unconstrained: bool = True,
         freeze_ratio: float = 0.1,
         levels: int | None = None,
-        skip_levels: Sequence[int] | None = None,
+        skip_levels: Sequence[int] | None = (1,),
         coarse_model: bool = True,
         expansion_phases: Sequence[float] | None = None,
         parallel: bool = False,
@@ -272,12 +272,17 @@ class NdtGrid:
             pose and maximises the summed score of its level and the next
             coarser one (that one as its quadratic model, see
             ``coarse_model``), so the last stage includes the fine cells.
-        skip_levels : sequence of int, optional
+        skip_levels : sequence of int, default (1,)
             Pyramid levels (1 to 11) the stages pass over: a skipped level is
             neither matched on nor prepared, and the stage below it pairs with
             the next matched coarser level. The coarsest matched level is
-            matched whatever this says. ``None`` (default): every level. The
-            odometry loop skips level 1 (4 cm; :class:`OdometryConfig`).
+            matched whatever this says. Default: level 1 (4 cm on a 2 cm
+            grid; ``None`` means the same), ``()``: every level. Skipping 4 cm
+            kept the successes of the benchmark's scan-to-scan pairs (6173 /
+            6050 of 7680 real SICK starts against 6182 / 6052 on every level,
+            held-out 6151 / 6064 against 6139 / 6060) and matches 16 % faster;
+            an insert then keeps one level's distributions fewer
+            (``BENCHMARK.md``, "Speed", session 18).
         coarse_model : bool, default True
             From the second stage on, score the coarser level of the stage by
             its second-order expansion about the stage's start (the same

@@ -172,8 +172,8 @@ pub struct MatchOptions {
     /// the stage below it takes the next matched coarser level as its window's
     /// coarser one. The fine level (bit 0) cannot be skipped; the coarsest
     /// matched level is matched whatever its bit says (it depends on
-    /// [`MatchOptions::levels`]). 0 (the default): every level. The odometry
-    /// loop skips the 4 cm level ([`crate::odometry::ODOMETRY_SKIP_LEVELS`]).
+    /// [`MatchOptions::levels`]). 0: every level. Default
+    /// [`DEFAULT_SKIP_LEVELS`] (level 1, 4 cm on a 2 cm grid).
     pub skip_levels: u32,
     /// From the second coarse-to-fine stage on, score the coarser level of
     /// the stage's window by its second-order expansion about the stage's
@@ -197,6 +197,19 @@ pub struct MatchOptions {
     /// use the cores better (the GIL is released while matching).
     pub parallel: bool,
 }
+
+/// The default [`MatchOptions::skip_levels`]: level 1 (4 cm cells on a 2 cm
+/// grid), as the odometry loop has skipped it since session 17
+/// ([`crate::odometry::ODOMETRY_SKIP_LEVELS`]). Scan-to-scan matches of the
+/// success sets of `benches/sigma_floor.py` (`benches/skip_levels.py`, 8
+/// starts per pair, local / wide): real SICK pairs 6173 / 6050 of 7680
+/// against 6182 / 6052 on every level, held-out SICK 6151 / 6064 against
+/// 6139 / 6060, URG-04LX 109 / 106 and simulated 128 / 126 both ways; the
+/// median match of URG-04LX scans of at least 500 points 0.163 against
+/// 0.195 ms, and the distributions an insert keeps up to date one level
+/// fewer (`insert_loop`: 1.04 → 0.89 M instructions per 683-point insert).
+/// BENCHMARK.md, "Speed", session 18.
+pub const DEFAULT_SKIP_LEVELS: u32 = 1 << 1;
 
 /// Smallest scan [`MatchOptions::parallel`] splits.
 pub const PARALLEL_MIN_POINTS: usize = 16384;
@@ -224,7 +237,7 @@ impl Default for MatchOptions {
             freeze_unconstrained: true,
             freeze_ratio: crate::degeneracy::FREEZE_RATIO,
             levels: None,
-            skip_levels: 0,
+            skip_levels: DEFAULT_SKIP_LEVELS,
             coarse_model: true,
             parallel: false,
         }

@@ -65,8 +65,9 @@ pub const ODOMETRY_TRANSLATION_TOLERANCE: f64 = 3e-4;
 /// session 17). Skipping 16 cm instead kept the errors too but saves less;
 /// skipping 8 cm (ACES 0.042 ± 0.044 m, largest 0.63 m) or 4 and 16 cm
 /// together (ACES largest 0.96 m, MIT Killian 1.79 m) did worse in single
-/// runs and was not pursued.
-pub const ODOMETRY_SKIP_LEVELS: u32 = 1 << 1;
+/// runs and was not pursued. Since session 18 also the default of every
+/// match ([`crate::matcher::DEFAULT_SKIP_LEVELS`]).
+pub const ODOMETRY_SKIP_LEVELS: u32 = crate::matcher::DEFAULT_SKIP_LEVELS;
 
 /// Largest coarsest-level cell \[m\] of the loop's matches when
 /// [`MatchOptions::levels`] is `None` (see [`OdometryConfig::matcher`]): 5

@@ -85,13 +85,13 @@ fn the_coarse_model_reports_the_exact_score_at_its_pose() {
         .unwrap();
     let check = MatchOptions {
         coarse_model: false,
-        levels: Some(2),
+        levels: Some(3),
         rotation_search: 0.0,
         max_iterations: 0,
         ..MatchOptions::default()
     };
-    // Two levels, no iteration: the second stage scores levels 0 and 1
-    // exactly at the start.
+    // Levels 2 and 0 (the default skips 4 cm), no iteration: the second
+    // stage scores levels 0 and 2 exactly at the start.
     let at = grid.match_scan(&scan, res.pose, &check).unwrap();
     assert_eq!(at.pose, res.pose);
     assert!(
@@ -184,7 +184,7 @@ fn the_rotation_gate_skips_the_multi_start_only_when_the_first_stage_explains_th
     );
 }
 
-/// `skip_levels` (the odometry loop's way of passing over the 4 cm level):
+/// `skip_levels` (the default passes over the 4 cm level):
 /// a match that skips middle levels still recovers the scan, never builds
 /// the skipped levels' distributions, and differs from the full match; the
 /// coarsest matched level is matched whatever its bit says; the fine level
@@ -206,8 +206,11 @@ fn skipped_levels_are_passed_over() {
         let res = grid.match_scan(&scan, guess, options).unwrap();
         (res, grid.heap_bytes())
     };
-    let (full, full_bytes) = run(&MatchOptions::default());
+    let (full, full_bytes) = run(&with_skip(0));
     let (skipped, skipped_bytes) = run(&with_skip(1 << 1));
+    // The default skips the 4 cm level.
+    let (default, _) = run(&MatchOptions::default());
+    assert_eq!(default.pose, skipped.pose);
     assert_ne!(full.pose, skipped.pose);
     // One level's distributions fewer (a 64-byte one per 4 cm cell at least).
     let fours = dense_map(0.02).level(1).map_or(0, |l| l.cells().len());
@@ -215,7 +218,7 @@ fn skipped_levels_are_passed_over() {
         full_bytes >= skipped_bytes + 64 * fours,
         "{full_bytes} {skipped_bytes} {fours}"
     );
-    // The default match has 6 levels: bit 5 (the coarsest) changes nothing.
+    // The match has 6 levels: bit 5 (the coarsest) changes nothing.
     let (top, _) = run(&with_skip(1 << 5));
     assert_eq!(
         (top.pose, top.score, top.iterations),

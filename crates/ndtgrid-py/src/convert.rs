@@ -182,13 +182,10 @@ pub fn level_mask(what: &str, levels: &[i64]) -> PyResult<u32> {
 }
 
 /// A mask of [`level_mask`] as `match`'s `skip_levels`: a tuple of the
-/// levels in increasing order, `None` for none.
-pub fn level_tuple(py: Python<'_>, mask: u32) -> PyResult<Option<Bound<'_, PyTuple>>> {
-    if mask == 0 {
-        return Ok(None);
-    }
+/// levels in increasing order (empty for none: `None` asks for the default).
+pub fn level_tuple(py: Python<'_>, mask: u32) -> PyResult<Bound<'_, PyTuple>> {
     let levels: Vec<u32> = (0..32).filter(|l| mask >> l & 1 == 1).collect();
-    PyTuple::new(py, levels).map(Some)
+    PyTuple::new(py, levels)
 }
 
 /// A non-negative integer option named `what`.

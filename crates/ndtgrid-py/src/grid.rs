@@ -128,7 +128,12 @@ impl PyNdtGrid {
         coarse_model = true,
         expansion_phases = None,
         parallel = false
-    ))]
+    ), text_signature = "($self, points, guess, *, expansion=10.0, sigma_floor=0.02, \
+        shape_cell=0.32, neighbor_search=True, fuse_minority=True, pair_neighbors=False, \
+        search_radius=1, max_iterations=50, translation_tolerance=1e-4, rotation_tolerance=1e-4, \
+        max_step_cells=2.0, max_step_rotation=0.05, rotation_search=0.15, rotation_gate=0.9, \
+        freeze_unconstrained=True, freeze_ratio=0.1, levels=None, skip_levels=(1,), \
+        coarse_model=True, expansion_phases=None, parallel=False)")]
     #[allow(clippy::too_many_arguments)]
     fn match_scan(
         &self,
@@ -175,7 +180,11 @@ impl PyNdtGrid {
             freeze_unconstrained,
             freeze_ratio,
             levels: levels.map(|l| count("levels", l)).transpose()?,
-            skip_levels: level_mask("skip_levels", skip_levels.as_deref().unwrap_or_default())?,
+            // `None`: the default (the signature shows it).
+            skip_levels: match skip_levels {
+                Some(l) => level_mask("skip_levels", &l)?,
+                None => MatchOptions::default().skip_levels,
+            },
             coarse_model,
             parallel,
         };
