@@ -280,8 +280,9 @@ class NdtGrid:
             grid; ``None`` means the same), ``()``: every level. Skipping 4 cm
             kept the successes of the benchmark's scan-to-scan pairs (6173 /
             6050 of 7680 real SICK starts against 6182 / 6052 on every level,
-            held-out 6151 / 6064 against 6139 / 6060) and matches 16 % faster;
-            an insert then keeps one level's distributions fewer
+            held-out 6151 / 6064 against 6139 / 6060; from starts up to
+            ±1.2 m and ±30° as many or more) and matches 16-27 % faster; an
+            insert then keeps one level's distributions fewer
             (``BENCHMARK.md``, "Speed", session 18).
         coarse_model : bool, default True
             From the second stage on, score the coarser level of the stage by

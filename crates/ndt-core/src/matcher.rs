@@ -44,7 +44,11 @@ pub const LEVEL_WINDOW: usize = 2;
 pub const DEFAULT_SHAPE_CELL: f64 = 0.32;
 
 /// Largest coarsest-level cell \[m\] of the automatic level count: the coarse
-/// stage must still see a room's walls as separate structures.
+/// stage must still see a room's walls as separate structures. Stopping at
+/// 32 cm instead (`benches/skip_levels.py`, session 18) matched as well from
+/// starts within ±0.4 m and ±10° and 6 % faster, but lost 38 / 52 / 132 of
+/// 3840 real SICK starts from ±0.6 / 0.8 / 1.2 m: the 64 cm level widens
+/// the basin.
 pub const AUTO_COARSEST_CELL: f64 = 0.64;
 
 /// The most pyramid levels, at least 1 and at most `available`, whose
@@ -204,11 +208,13 @@ pub struct MatchOptions {
 /// success sets of `benches/sigma_floor.py` (`benches/skip_levels.py`, 8
 /// starts per pair, local / wide): real SICK pairs 6173 / 6050 of 7680
 /// against 6182 / 6052 on every level, held-out SICK 6151 / 6064 against
-/// 6139 / 6060, URG-04LX 109 / 106 and simulated 128 / 126 both ways; the
-/// median match of URG-04LX scans of at least 500 points 0.163 against
-/// 0.195 ms, and the distributions an insert keeps up to date one level
-/// fewer (`insert_loop`: 1.04 → 0.89 M instructions per 683-point insert).
-/// BENCHMARK.md, "Speed", session 18.
+/// 6139 / 6060, URG-04LX 109 / 107 and simulated 128 / 126 both ways, and
+/// from wider starts (±0.6 to ±1.2 m, ±15 to ±30°) 2918 / 2640 / 1946 of
+/// 3840 SICK starts against 2917 / 2635 / 1943; the median match of URG-04LX
+/// scans of at least 500 points 16–27 % faster in three runs (0.141 against
+/// 0.187 ms in the last), and the distributions an insert keeps up to date
+/// one level fewer (`insert_loop`: 1.04 → 0.89 M instructions per 683-point
+/// insert). BENCHMARK.md, "Speed", session 18.
 pub const DEFAULT_SKIP_LEVELS: u32 = 1 << 1;
 
 /// Smallest scan [`MatchOptions::parallel`] splits.
