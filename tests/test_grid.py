@@ -175,6 +175,16 @@ def test_documented_defaults_are_the_core_defaults() -> None:
     for name, value in core.items():
         assert stub_defaults[name] == value, name
         assert binding[name] == value, name
+    # The signature's text is written out (a tuple default), so also: a match with the
+    # binding's own defaults equals one given the core's explicitly (this catches a
+    # default that changes this match, e.g. sigma_floor, expansion or skip_levels).
+    pts, guess = scan((0.1, 0.0, 0.2), seed=9), np.array([0.12, -0.01, 0.21])
+    implicit, explicit = room_map().match(pts, guess), room_map().match(pts, guess, **core)
+    assert (implicit.pose.tolist(), implicit.score, implicit.iterations) == (
+        explicit.pose.tolist(),
+        explicit.score,
+        explicit.iterations,
+    )
 
 
 def test_se2_helpers_round_trip() -> None:
