@@ -167,8 +167,12 @@ pub fn mat3<'py>(py: Python<'py>, m: [[f64; 3]; 3]) -> PyResult<Bound<'py, PyArr
 }
 
 /// Pyramid levels named by number (option `what`, e.g. `skip_levels`) as a
-/// mask, bit `l` for level `l`: each between 1 and the pyramid's last.
-pub fn level_mask(what: &str, levels: &[i64]) -> PyResult<u32> {
+/// mask, bit `l` for level `l`: each between 1 and the pyramid's last;
+/// `default` when not given (`None`).
+pub fn level_mask(what: &str, levels: Option<&[i64]>, default: u32) -> PyResult<u32> {
+    let Some(levels) = levels else {
+        return Ok(default);
+    };
     let last = ndt_core::pyramid::MAX_LEVELS as i64 - 1;
     levels.iter().try_fold(0u32, |mask, &l| {
         if (1..=last).contains(&l) {

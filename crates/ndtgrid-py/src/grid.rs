@@ -181,10 +181,11 @@ impl PyNdtGrid {
             freeze_ratio,
             levels: levels.map(|l| count("levels", l)).transpose()?,
             // `None`: the default (the signature shows it).
-            skip_levels: match skip_levels {
-                Some(l) => level_mask("skip_levels", &l)?,
-                None => MatchOptions::default().skip_levels,
-            },
+            skip_levels: level_mask(
+                "skip_levels",
+                skip_levels.as_deref(),
+                MatchOptions::default().skip_levels,
+            )?,
             coarse_model,
             parallel,
         };

@@ -197,10 +197,7 @@ impl PyOdometry {
                 Some(l) => Some(count("levels", l)?),
                 None => m.levels,
             },
-            skip_levels: match skip_levels {
-                Some(l) => level_mask("skip_levels", &l)?,
-                None => m.skip_levels,
-            },
+            skip_levels: level_mask("skip_levels", skip_levels.as_deref(), m.skip_levels)?,
             rotation_search: coarse_rotation_search.unwrap_or(m.rotation_search),
             freeze_unconstrained: freeze_unconstrained.unwrap_or(m.freeze_unconstrained),
             freeze_ratio: freeze_ratio.unwrap_or(m.freeze_ratio),
