@@ -4,7 +4,9 @@
 //! configuration; `inline`: `background_mapper: false`; `loop-only`: the
 //! mapper takes the first scan only, so the loop runs without a mapper's
 //! work beside it, with the same poses) over every scan, `reps` times;
-//! prints the time per scan and the last pose.
+//! prints the time per scan, the last pose and a hash of the mapper (every
+//! pyramid level's sums and the §V filter's records), so two builds can be
+//! compared for bit-identical maps.
 //! `replay <dump> matchhash`: the first 3000 scans matched with the default
 //! options against a map that takes every third scan and loses every 17th
 //! cell (in key order) every 50 scans; prints a hash of every pose's and
@@ -21,7 +23,7 @@ use std::error::Error;
 use std::time::Instant;
 
 use ndt_core::odometry::{Odometry, OdometryConfig};
-use ndt_core::{points_from_ranges, CellKey, MatchOptions, NdtGrid, Pose2};
+use ndt_core::{points_from_ranges, CellKey, Mapper, MatchOptions, NdtGrid, Pose2};
 use rustc_hash::FxHashMap;
 
 type Scan = (Vec<f64>, Vec<f64>, Option<Pose2>);
@@ -88,16 +90,43 @@ fn odometry(scans: &[Scan], reps: usize, variant: Option<&str>) -> Result<(), Bo
         let s = t.elapsed().as_secs_f64();
         let last = odo.poses().last().copied().unwrap_or_default();
         println!(
-            "{} scans {s:.3} s ({cpu:.2} s CPU on the loop's thread) {:.4} ms/scan, {} inserted, {cells} mapper cells, last pose {:.12} {:.12} {:.12}",
+            "{} scans {s:.3} s ({cpu:.2} s CPU on the loop's thread) {:.4} ms/scan, {} inserted, {cells} mapper cells (hash {:016x}), last pose {:.12} {:.12} {:.12}",
             scans.len(),
             1e3 * s / scans.len() as f64,
             odo.insertions(),
+            mapper_hash(&odo.mapper()),
             last.x,
             last.y,
             last.theta
         );
     }
     Ok(())
+}
+
+/// A hash of every level's sums (in key order) and the filter's records.
+fn mapper_hash(mapper: &Mapper) -> u64 {
+    let mut hash: u64 = 0;
+    let mut add = |v: u64| hash = hash.rotate_left(5) ^ v;
+    let grid = mapper.grid();
+    for l in 0..grid.levels() {
+        let Some(level) = grid.level(l) else { break };
+        let mut cells: Vec<_> = level.cells().iter().collect();
+        cells.sort_unstable_by_key(|(k, _)| *k);
+        for (k, c) in cells {
+            add(u64::from(k.ix as u32) << 32 | u64::from(k.iy as u32));
+            add(c.count);
+            for v in c.sum.iter().chain(c.scatter.iter()) {
+                add(v.to_bits());
+            }
+        }
+    }
+    for (k, info) in mapper.filter().cell_records() {
+        add(u64::from(k.ix as u32) << 32 | u64::from(k.iy as u32));
+        add(info.first_seen ^ info.last_seen.rotate_left(32));
+        add(u64::from(info.observations) << 32 | u64::from(info.small_observations));
+        add(u64::from(info.seen_in_area1));
+    }
+    hash
 }
 
 fn matchhash(scans: &[Scan]) -> Result<(), Box<dyn Error>> {

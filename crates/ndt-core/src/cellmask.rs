@@ -13,8 +13,8 @@ use rustc_hash::FxHashMap;
 use crate::key::CellKey;
 use crate::parity::ParityMemo;
 
-/// log2 of a block's side \[cells\].
-const BLOCK_BITS: i32 = 3;
+/// log2 of a block's side \[cells\] (a block is one word).
+pub const BLOCK_BITS: i32 = 3;
 const MASK: i32 = (1 << BLOCK_BITS) - 1;
 
 /// One bit per cell of a set of cells.
@@ -50,15 +50,17 @@ impl CellMask {
     /// Puts each key of `keys` in the set or takes it out as `member` says:
     /// one look-up per run of keys in one block.
     pub fn set_each(&mut self, keys: &[CellKey], mut member: impl FnMut(CellKey) -> bool) {
+        self.set_pairs(keys.iter().map(|&k| (k, member(k))));
+    }
+
+    /// Puts each key of `pairs` in the set (`true`) or takes it out, in
+    /// order: one look-up per run of keys in one block.
+    pub fn set_pairs(&mut self, pairs: impl IntoIterator<Item = (CellKey, bool)>) {
         // The current block with the bits to set and to clear in it.
         let mut run: Option<((i32, i32), u64, u64)> = None;
-        for &key in keys {
+        for (key, member) in pairs {
             let (block, bit) = split(key);
-            let (set, clear) = if member(key) {
-                (1 << bit, 0)
-            } else {
-                (0, 1 << bit)
-            };
+            let (set, clear) = if member { (1 << bit, 0) } else { (0, 1 << bit) };
             match &mut run {
                 Some((b, s, c)) if *b == block => {
                     *s |= set;
@@ -93,6 +95,13 @@ impl CellMask {
     /// Puts `key` in the set (`true`) or takes it out.
     pub fn set(&mut self, key: CellKey, member: bool) {
         self.set_all(&[key], member);
+    }
+
+    /// Every block with a member: its index (cell index `>> BLOCK_BITS`)
+    /// and its word (bit `(iy mod 8) · 8 + (ix mod 8)`), in no particular
+    /// order.
+    pub fn words(&self) -> impl Iterator<Item = ((i32, i32), u64)> + '_ {
+        self.blocks.iter().map(|(&b, &w)| (b, w))
     }
 
     /// A reader that remembers the last block it used.
@@ -139,6 +148,27 @@ impl CellMaskReader<'_> {
         let w = self.mask.blocks.get(&block).copied().unwrap_or(0);
         self.last.set(block, w);
         w
+    }
+
+    /// Whether the set has a member in the quarter of a block (a square of
+    /// `2^(BLOCK_BITS − 1)` cells a side, aligned as the blocks) holding
+    /// `key`: the quarter's rows of the block's word.
+    #[inline]
+    pub fn any_in_quarter(&mut self, key: CellKey) -> bool {
+        const HALF: i32 = 1 << (BLOCK_BITS - 1);
+        // HALF rows of HALF bits at the block's origin.
+        const QUARTER: u64 = {
+            let row = (1u64 << HALF) - 1;
+            let mut m = 0;
+            let mut r = 0;
+            while r < HALF {
+                m |= row << (r << BLOCK_BITS);
+                r += 1;
+            }
+            m
+        };
+        let shift = ((key.iy & HALF) << BLOCK_BITS) | (key.ix & HALF);
+        self.word(split(key).0) & (QUARTER << shift) != 0
     }
 
     /// `true` when `key` is in the set.

@@ -9,11 +9,13 @@ use crate::cell::CellStats;
 use crate::distributions::{DistOptions, Distributions};
 use crate::error::{check_finite, NdtError, Result};
 use crate::key::{CellKey, KeyBounds, MAX_INDEX};
+use crate::occupancy::OccupancyProbe;
 use crate::pyramid::{Level, Pyramid, MAX_LEVELS};
 use crate::se2::Pose2;
 use crate::shape::{Shape, ShapeMemo};
 use crate::table::CellTable;
 
+mod deferral;
 mod edit;
 
 pub use edit::MAX_CELL_COUNT;
@@ -78,6 +80,11 @@ pub struct NdtGrid {
     inv_cell_size: f64,
     pyramid: Pyramid,
     prepared: Mutex<Vec<Arc<Distributions>>>,
+    /// Fine cells changed while a deferral ([`NdtGrid::deferral`]) was open: their coarser
+    /// levels and prepared distributions wait for its end (empty otherwise).
+    pending: Vec<CellKey>,
+    /// Open deferrals (they nest).
+    deferring: u32,
 }
 
 impl Clone for NdtGrid {
@@ -94,6 +101,8 @@ impl Clone for NdtGrid {
                     .map(|d| Arc::new(Distributions::clone(d)))
                     .collect(),
             ),
+            pending: self.pending.clone(),
+            deferring: self.deferring,
         }
     }
 }
@@ -127,6 +136,8 @@ impl NdtGrid {
             inv_cell_size: 1.0 / cell_size,
             pyramid: Pyramid::new(cell_size, levels),
             prepared: Mutex::new(Vec::new()),
+            pending: Vec::new(),
+            deferring: 0,
         })
     }
 
@@ -137,6 +148,10 @@ impl NdtGrid {
 
     /// Pyramid level `l` (0 = fine): its cell size and sums.
     pub fn level(&self, l: usize) -> Option<&Level> {
+        debug_assert!(
+            l == 0 || self.pending.is_empty(),
+            "coarse level read in a deferral"
+        );
         self.pyramid.level(l)
     }
 
@@ -167,7 +182,7 @@ impl NdtGrid {
     /// The occupied cells as a bit mask: answers "does this cell hold points?"
     /// for runs of cells (a beam's path) without touching the sums.
     pub fn occupancy(&self) -> crate::cellmask::CellMaskReader<'_> {
-        self.pyramid.occupied().reader()
+        self.pyramid.occupied().cells().reader()
     }
 
     /// The sums of one cell about its centre, if it holds points.
@@ -250,6 +265,11 @@ impl NdtGrid {
     /// every pyramid level, then the prepared distributions of the touched
     /// cells. Returns the touched finest-level keys (see [`NdtGrid::insert`]).
     pub(crate) fn insert_staged(&mut self, staged: StagedScan) -> Vec<CellKey> {
+        if self.deferring > 0 {
+            let fine = self.pyramid.add_fine(&staged.points);
+            self.pending.extend_from_slice(&fine);
+            return fine;
+        }
         let touched = self.pyramid.add(&staged.points);
         self.update_prepared(&touched);
         touched.into_iter().next().unwrap_or_default()
@@ -265,6 +285,11 @@ impl NdtGrid {
     ///
     /// Returns the number of cells removed. Cannot fail.
     pub fn remove_cells(&mut self, keys: &[CellKey]) -> usize {
+        if self.deferring > 0 {
+            let removed = self.pyramid.remove_fine(keys);
+            self.pending.extend_from_slice(&removed);
+            return removed.len();
+        }
         let touched = self.pyramid.remove(keys);
         let removed = touched.first().map_or(0, Vec::len);
         if removed == 0 {
@@ -328,6 +353,7 @@ impl NdtGrid {
         level: usize,
         options: DistOptions,
     ) -> Option<Arc<Distributions>> {
+        debug_assert!(self.pending.is_empty(), "distributions read in a deferral");
         let lv = self.pyramid.level(level)?;
         let mut prepared = self.lock_prepared();
         if let Some(found) = prepared
@@ -358,118 +384,15 @@ impl NdtGrid {
     }
 }
 
-/// Levels above the fine one that [`OccupancyProbe`] looks at (16 × 16 fine
-/// cells per ancestor). `Odometry` on the Intel log (ms per scan, two runs):
-/// 3 levels 0.499 / 0.497, 4 levels 0.490 / 0.496, 5 levels 0.512 / 0.499;
-/// `cargo bench --bench odometry`: 467, 447 and 453 µs.
-const PROBE_DEPTH: usize = 4;
-
-/// Answers "may fine cell `key` hold points?" from a coarser pyramid level:
-/// no fine cell exists under an absent ancestor (every level is summed from
-/// the fine cells, and a fine cell holds at least one point). Remembers the
-/// last ancestor asked about, so a walk along a beam through empty space
-/// looks one ancestor up per block of fine cells instead of every fine cell,
-/// and [`crate::filter::raywalk::walk_cells_in_skipping`] crosses the empty
-/// blocks without visiting their cells. It answers the same question on
-/// smaller blocks too ([`OccupancyProbe::may_hold_inner`]), for the walk
-/// through the blocks that are not empty.
-#[derive(Debug)]
-pub struct OccupancyProbe<'a> {
-    blocks: BlockProbe<'a>,
-    /// The same on the smaller blocks ([`INNER_PROBE_DEPTH`], fewer levels
-    /// than the blocks).
-    inner: BlockProbe<'a>,
-}
-
-/// One level of an [`OccupancyProbe`]: the ancestors `depth` levels above
-/// the fine cells (`None`: no such level, every cell may hold points), and
-/// the last one asked about.
-#[derive(Debug)]
-struct BlockProbe<'a> {
-    ancestors: Option<crate::table::Cursor<'a, CellStats>>,
-    depth: usize,
-    last: Option<(CellKey, bool)>,
-}
-
-impl<'a> BlockProbe<'a> {
-    /// The ancestors `depth` levels above the fine cells of `grid` (none at
-    /// depth 0).
-    fn of(grid: &'a NdtGrid, depth: usize) -> Self {
-        Self {
-            ancestors: (depth > 0)
-                .then(|| grid.pyramid.level(depth).map(|l| l.cells().cursor()))
-                .flatten(),
-            depth,
-            last: None,
-        }
-    }
-
-    fn bits(&self) -> Option<u32> {
-        self.ancestors.as_ref().map(|_| self.depth as u32)
-    }
-
-    /// `false` only when no fine cell `key` exists under its ancestor.
-    #[inline]
-    fn may_hold(&mut self, key: CellKey) -> bool {
-        let Some(cells) = self.ancestors.as_mut() else {
-            return true;
-        };
-        let at = crate::pyramid::coarse_key(key, self.depth);
-        match self.last {
-            Some((k, found)) if k == at => found,
-            _ => {
-                let found = cells.get(at).is_some();
-                self.last = Some((at, found));
-                found
-            }
-        }
-    }
-}
-
-/// Levels above the fine one of the smaller blocks [`OccupancyProbe`] also
-/// looks at, inside the blocks of [`PROBE_DEPTH`] that hold cells (4 × 4
-/// fine cells): a beam crossing such a block near a wall skips the parts of
-/// it away from the wall. `replay intel3k odometry 1 inline` (callgrind):
-/// without them 4.880 G instructions (the §V walks visited 4.09 M cells), 1
-/// level up 4.824 G, 2 levels 4.711 G (0.81 M cells visited), 3 levels
-/// 4.764 G; the final maps are the same.
-const INNER_PROBE_DEPTH: usize = 2;
-
-impl OccupancyProbe<'_> {
-    /// log2 of the side \[fine cells\] of the blocks [`OccupancyProbe::may_hold`]
-    /// answers for as a whole; `None` when it answers `true` for every cell.
-    pub fn block_bits(&self) -> Option<u32> {
-        self.blocks.bits()
-    }
-
-    /// log2 of the side \[fine cells\] of the smaller blocks
-    /// [`OccupancyProbe::may_hold_inner`] answers for; `None` when none.
-    pub fn inner_bits(&self) -> Option<u32> {
-        self.inner.bits()
-    }
-
-    /// `false` only when no fine cell `key` exists; `true` when it may.
-    #[inline]
-    pub fn may_hold(&mut self, key: CellKey) -> bool {
-        self.blocks.may_hold(key)
-    }
-
-    /// [`OccupancyProbe::may_hold`] on the smaller blocks.
-    #[inline]
-    pub fn may_hold_inner(&mut self, key: CellKey) -> bool {
-        self.inner.may_hold(key)
-    }
-}
-
 impl NdtGrid {
-    /// An [`OccupancyProbe`] of this grid (with a single-level grid it
-    /// answers `true` for every cell).
+    /// An [`OccupancyProbe`] of this grid: "may a cell of this block hold
+    /// points?" on blocks of 16 × 16 and 4 × 4 fine cells, from the
+    /// occupancy masks (see [`crate::occupancy`]). It read the pyramid's
+    /// 32 cm and 8 cm levels before (the same blocks on a 2 cm grid, the
+    /// same answers): `replay intel3k odometry 1 inline`, callgrind, in
+    /// BENCHMARK.md, "Speed", session 19.
     pub fn occupancy_probe(&self) -> OccupancyProbe<'_> {
-        let depth = PROBE_DEPTH.min(self.levels() - 1);
-        OccupancyProbe {
-            blocks: BlockProbe::of(self, depth),
-            inner: BlockProbe::of(self, INNER_PROBE_DEPTH.min(depth.saturating_sub(1))),
-        }
+        self.pyramid.occupied().probe()
     }
 }
 

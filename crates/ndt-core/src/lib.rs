@@ -38,6 +38,7 @@ pub mod matcher;
 pub mod memo;
 pub mod moments;
 pub mod neighbor;
+pub mod occupancy;
 pub mod odometry;
 pub mod pairs;
 mod parity;

@@ -91,6 +91,7 @@ fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
 /// A checked scan into `mapper`, then the window's removals `stale`: what a
 /// job does, and what the loop does in line.
 fn apply_scan(mapper: &mut Mapper, scan: CheckedScan, stale: &[CellKey]) -> Result<()> {
+    let mut mapper = mapper.batch();
     mapper.insert_checked(scan)?;
     mapper.remove_cells(stale);
     Ok(())
@@ -103,15 +104,19 @@ fn serve_batch(shared: &Shared, batch: Vec<Job>) {
         shared,
         result: Ok(()),
     };
-    let mut mapper = shared.mapper.write().unwrap_or_else(|e| e.into_inner());
+    let mut guard = shared.mapper.write().unwrap_or_else(|e| e.into_inner());
+    // The batch's scans bring the coarser levels up to date once, at its
+    // end (NdtGrid::deferral, crate/src/grid/deferral.rs): the same map, bit for bit.
+    let mut mapper = guard.batch();
     for job in batch {
         let result = apply_scan(&mut mapper, job.scan, &job.stale);
         if done.result.is_ok() {
             done.result = result;
         }
     }
-    // The mapper is unlocked before the batch counts as done.
+    // The mapper is settled and unlocked before the batch counts as done.
     drop(mapper);
+    drop(guard);
 }
 
 /// The helper thread: runs the batches in order until the loop hangs up.

@@ -6,9 +6,9 @@
 use nalgebra::Vector2;
 
 use crate::cell::CellStats;
-use crate::cellmask::CellMask;
 use crate::gather;
 use crate::key::{CellKey, KeyBounds};
+use crate::occupancy::Occupancy;
 use crate::scratch::KeyScratch;
 use crate::table::CellTable;
 
@@ -45,8 +45,8 @@ pub struct Pyramid {
     /// A superset of the fine keys in use: grown by every insert, reset when
     /// the fine level empties (removals do not shrink it).
     bounds: Option<KeyBounds>,
-    /// The occupied fine cells, a bit each (see [`crate::cellmask`]).
-    occupied: CellMask,
+    /// The occupied fine cells (see [`crate::occupancy`]).
+    occupied: Occupancy,
     /// The keys an update has met (reused between updates).
     seen: KeyScratch,
 }
@@ -73,7 +73,7 @@ impl Pyramid {
         Self {
             levels,
             bounds: None,
-            occupied: CellMask::default(),
+            occupied: Occupancy::default(),
             seen: KeyScratch::default(),
         }
     }
@@ -85,7 +85,7 @@ impl Pyramid {
     }
 
     /// The occupied fine cells.
-    pub fn occupied(&self) -> &CellMask {
+    pub fn occupied(&self) -> &Occupancy {
         &self.occupied
     }
 
@@ -123,6 +123,14 @@ impl Pyramid {
     ///
     /// Returns, per level, the keys of the cells that changed.
     pub fn add(&mut self, staged: &[(CellKey, Vector2<f64>)]) -> Vec<Vec<CellKey>> {
+        let touched = self.add_fine(staged);
+        self.refresh_parents(touched)
+    }
+
+    /// The fine level's part of [`Pyramid::add`]: eq. (6) for the points
+    /// `staged`, the occupancy and the bounds; the coarser levels are left
+    /// for [`Pyramid::refresh`]. Returns the fine cells that changed.
+    pub fn add_fine(&mut self, staged: &[(CellKey, Vector2<f64>)]) -> Vec<CellKey> {
         let fine = &mut self.levels[0];
         let seen = self.seen.take();
         let mut touched = Vec::with_capacity(staged.len());
@@ -150,14 +158,27 @@ impl Pyramid {
         if let Some((k, stats)) = run {
             flush(k, &stats);
         }
-        self.occupied.set_all(&touched, true);
+        self.occupied.insert(&touched);
         if let Some(added) = KeyBounds::of_keys(touched.iter().copied()) {
             self.bounds = Some(match self.bounds {
                 Some(b) => b.including(added.min).including(added.max),
                 None => added,
             });
         }
-        self.refresh_parents(touched)
+        touched
+    }
+
+    /// Brings the coarser levels up to date after the fine cells `fine`
+    /// changed by [`Pyramid::add_fine`] and [`Pyramid::remove_fine`] (in any
+    /// number of calls, a cell possibly more than once): each coarser cell
+    /// above them is re-summed once. The levels are then the same, bit for
+    /// bit, as after [`Pyramid::add`] and [`Pyramid::remove`] call by call
+    /// (a coarse cell is a function of the fine cells alone). Returns the
+    /// changed keys per level (level 0: `fine`, each once).
+    pub fn refresh(&mut self, fine: &[CellKey]) -> Vec<Vec<CellKey>> {
+        let seen = self.seen.take();
+        let once: Vec<CellKey> = fine.iter().copied().filter(|&k| seen.insert(k)).collect();
+        self.refresh_parents(once)
     }
 
     /// Re-sums, level by level, every coarse cell above the changed fine
@@ -208,6 +229,13 @@ impl Pyramid {
     /// Returns, per level, the keys of the cells that changed (level 0: the
     /// fine cells actually removed).
     pub fn remove(&mut self, keys: &[CellKey]) -> Vec<Vec<CellKey>> {
+        let removed = self.remove_fine(keys);
+        self.refresh_parents(removed)
+    }
+
+    /// The fine level's part of [`Pyramid::remove`] (see
+    /// [`Pyramid::add_fine`]). Returns the fine cells actually removed.
+    pub fn remove_fine(&mut self, keys: &[CellKey]) -> Vec<CellKey> {
         let seen = self.seen.take();
         let mut removed = Vec::new();
         for &key in keys {
@@ -215,11 +243,11 @@ impl Pyramid {
                 removed.push(key);
             }
         }
-        self.occupied.set_all(&removed, false);
+        self.occupied.remove(&removed);
         if self.levels[0].cells.is_empty() {
             self.bounds = None;
         }
-        self.refresh_parents(removed)
+        removed
     }
 }
 
@@ -229,7 +257,7 @@ impl Pyramid {
     pub fn set_fine(&mut self, states: &[(CellKey, CellStats)]) {
         self.levels[0].cells = states.iter().copied().collect();
         self.bounds = KeyBounds::of_keys(states.iter().map(|(k, _)| *k));
-        self.occupied = CellMask::of(states.iter().map(|(k, _)| *k));
+        self.occupied = Occupancy::of(states.iter().map(|(k, _)| *k));
         for level in &mut self.levels[1..] {
             level.cells.clear();
         }

@@ -43,14 +43,19 @@ fn the_probe_admits_every_occupied_cell_and_rules_out_empty_blocks() {
         ruled_out_inner > ruled_out + (empty - ruled_out) / 2,
         "{ruled_out_inner} of {empty} empty cells ruled out by the smaller blocks"
     );
-    // A one-level grid has no coarser level to ask: it admits everything.
-    let single = NdtGrid::with_levels(0.02, 1).unwrap();
-    let mut probe = single.occupancy_probe();
-    assert_eq!((probe.block_bits(), probe.inner_bits()), (None, None));
-    assert!(probe.may_hold(CellKey { ix: 5, iy: 5 }));
-    assert!(probe.may_hold_inner(CellKey { ix: 5, iy: 5 }));
-    // With 3 levels the blocks are 4 × 4 cells and the smaller ones 2 × 2.
-    let three = NdtGrid::with_levels(0.02, 3).unwrap();
-    let probe = three.occupancy_probe();
-    assert_eq!((probe.block_bits(), probe.inner_bits()), (Some(2), Some(1)));
+    // The probe reads the occupancy, not the pyramid: a one-level grid
+    // rules out empty blocks as well, with the same block sizes.
+    let mut single = NdtGrid::with_levels(0.02, 1).unwrap();
+    single.insert(&pts, Pose2::identity()).unwrap();
+    single.remove_cells(&keys[..keys.len() / 3]);
+    let mut one = single.occupancy_probe();
+    let mut six = grid.occupancy_probe();
+    assert_eq!((one.block_bits(), one.inner_bits()), (Some(4), Some(2)));
+    for ix in -120..120 {
+        for iy in -120..120 {
+            let key = CellKey { ix, iy };
+            assert_eq!(one.may_hold(key), six.may_hold(key), "{key:?}");
+            assert_eq!(one.may_hold_inner(key), six.may_hold_inner(key), "{key:?}");
+        }
+    }
 }

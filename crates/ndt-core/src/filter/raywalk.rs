@@ -41,16 +41,16 @@ pub trait EmptyBlocks {
     }
 }
 
-/// The blocks a grid's pyramid shows empty ([`crate::grid::OccupancyProbe`]).
-impl EmptyBlocks for crate::grid::OccupancyProbe<'_> {
+/// The blocks a grid's occupancy shows empty ([`crate::occupancy::OccupancyProbe`]).
+impl EmptyBlocks for crate::occupancy::OccupancyProbe<'_> {
     fn block_bits(&self) -> Option<u32> {
-        crate::grid::OccupancyProbe::block_bits(self)
+        crate::occupancy::OccupancyProbe::block_bits(self)
     }
     fn is_empty(&mut self, key: CellKey) -> bool {
         !self.may_hold(key)
     }
     fn inner_bits(&self) -> Option<u32> {
-        crate::grid::OccupancyProbe::inner_bits(self)
+        crate::occupancy::OccupancyProbe::inner_bits(self)
     }
     fn inner_is_empty(&mut self, key: CellKey) -> bool {
         !self.may_hold_inner(key)

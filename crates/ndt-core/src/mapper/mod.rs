@@ -95,6 +95,9 @@ impl MapFilter {
     /// Cells too young for step c are left alone. Returns the number of
     /// cells deleted.
     pub fn run_checks(&mut self, grid: &mut NdtGrid) -> usize {
+        // Both steps' deletions bring the coarser levels up to date once.
+        let mut deferred = grid.deferral();
+        let grid: &mut NdtGrid = &mut deferred;
         // Forget cells that left the grid by other means (asked of the
         // grid's occupancy mask, not its sums: the whole table every check).
         let mut occupied = grid.occupancy();
@@ -228,5 +231,38 @@ impl Mapper {
     /// Runs the periodic checks now (see [`MapFilter::run_checks`]).
     pub fn run_checks(&mut self) -> usize {
         self.filter.run_checks(&mut self.grid)
+    }
+
+    /// This mapper with its grid's coarser levels brought up to date once,
+    /// when the batch is dropped, instead of after every change (see
+    /// [`NdtGrid::deferral`]): for runs of inserts and removals that
+    /// read nothing but the fine level meanwhile.
+    pub(crate) fn batch(&mut self) -> MapperBatch<'_> {
+        self.grid.begin_deferral();
+        MapperBatch { mapper: self }
+    }
+}
+
+/// A [`Mapper`] in a batch (see [`Mapper::batch`]).
+pub(crate) struct MapperBatch<'a> {
+    mapper: &'a mut Mapper,
+}
+
+impl Drop for MapperBatch<'_> {
+    fn drop(&mut self) {
+        self.mapper.grid.end_deferral();
+    }
+}
+
+impl std::ops::Deref for MapperBatch<'_> {
+    type Target = Mapper;
+    fn deref(&self) -> &Mapper {
+        self.mapper
+    }
+}
+
+impl std::ops::DerefMut for MapperBatch<'_> {
+    fn deref_mut(&mut self) -> &mut Mapper {
+        self.mapper
     }
 }

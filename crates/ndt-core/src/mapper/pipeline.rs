@@ -66,6 +66,10 @@ impl MapFilter {
         checked: CheckedScan,
     ) -> Result<()> {
         let CheckedScan { beams, pose } = checked;
+        // The insert and the deletions below (and a periodic check's) bring
+        // the coarser levels up to date once (NdtGrid::deferral, crate/src/grid/deferral.rs).
+        let mut deferred = grid.deferral();
+        let grid: &mut NdtGrid = &mut deferred;
         // A scan with no valid beam (a blinded sensor, a driver sending only
         // NaN, 0 or inf) observes nothing: it changes neither the map nor the
         // filter, not even the scan counter, so a burst of them cannot age

@@ -1,0 +1,207 @@
+//! Which fine cells hold points, kept exact under every insert and removal:
+//! a bit per cell ([`CellMask`]), and, once a probe has asked, a bit per
+//! block of 4 × 4 cells that holds any. The second answers, for the §V beam
+//! walks ([`crate::filter::raywalk::walk_cells_in_skipping`]), "may a cell
+//! of this block hold points?" on blocks of 16 × 16 cells (a quarter of one
+//! of its words) and of 4 × 4 (one of its bits) with one look-up per 32 × 32
+//! cells, and without the pyramid's coarser levels, so it holds while those
+//! wait to be brought up to date (a deferral, `NdtGrid::deferral`). A grid that
+//! is never walked (the odometry loop's matching grid) never builds it.
+
+use std::sync::OnceLock;
+
+use crate::cellmask::{CellMask, CellMaskReader, BLOCK_BITS as WORD_BITS};
+use crate::key::CellKey;
+
+/// log2 of the side \[cells\] of the blocks with a bit each.
+const SMALL_BITS: i32 = 2;
+
+/// The block of 4 × 4 cells holding `key`, as a key of that lattice.
+#[inline]
+fn small_block(key: CellKey) -> CellKey {
+    CellKey {
+        ix: key.ix >> SMALL_BITS,
+        iy: key.iy >> SMALL_BITS,
+    }
+}
+
+/// The occupied fine cells of a grid (see the module docs).
+#[derive(Debug, Clone, Default)]
+pub struct Occupancy {
+    cells: CellMask,
+    /// The occupied blocks of 4 × 4 cells, built at the first
+    /// [`Occupancy::probe`] and kept up to date from then on.
+    blocks: OnceLock<CellMask>,
+}
+
+/// The same cells (the blocks follow from them).
+impl PartialEq for Occupancy {
+    fn eq(&self, other: &Self) -> bool {
+        self.cells == other.cells
+    }
+}
+
+/// The occupied blocks of 4 × 4 cells of the cells `cells`: each word of
+/// `cells` (8 × 8 cells) gives the bits of its occupied quarters.
+fn blocks_of(cells: &CellMask) -> CellMask {
+    const HALF: i32 = 1 << (WORD_BITS - 1);
+    let quarter = |qx: i32, qy: i32| -> u64 {
+        let row = (1u64 << HALF) - 1;
+        (0..HALF).fold(0, |m, r| m | row << ((qy * HALF + r) << WORD_BITS)) << (qx * HALF)
+    };
+    let mut blocks = CellMask::default();
+    let mut keys = Vec::new();
+    for ((bx, by), word) in cells.words() {
+        for (qx, qy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            if word & quarter(qx, qy) != 0 {
+                keys.push(CellKey {
+                    ix: bx * 2 + qx,
+                    iy: by * 2 + qy,
+                });
+            }
+        }
+    }
+    blocks.set_all(&keys, true);
+    blocks
+}
+
+impl Occupancy {
+    /// The occupancy of exactly the cells `keys`.
+    pub fn of(keys: impl IntoIterator<Item = CellKey>) -> Self {
+        Self {
+            cells: CellMask::of(keys),
+            blocks: OnceLock::new(),
+        }
+    }
+
+    /// The cells `keys` now hold points.
+    pub fn insert(&mut self, keys: &[CellKey]) {
+        self.cells.set_all(keys, true);
+        if let Some(blocks) = self.blocks.get_mut() {
+            blocks.set_pairs(keys.iter().map(|&k| (small_block(k), true)));
+        }
+    }
+
+    /// The cells `keys` hold no points any more; a block loses its bit
+    /// with its last cell (its 4 × 4 cells are a quarter of one word of the
+    /// cells' mask).
+    pub fn remove(&mut self, keys: &[CellKey]) {
+        self.cells.set_all(keys, false);
+        let Some(blocks) = self.blocks.get_mut() else {
+            return;
+        };
+        let mut cells = self.cells.reader();
+        let emptied: Vec<CellKey> = keys
+            .iter()
+            .filter(|&&k| !cells.any_in_quarter(k))
+            .map(|&k| small_block(k))
+            .collect();
+        blocks.set_all(&emptied, false);
+    }
+
+    /// One bit per occupied cell.
+    pub fn cells(&self) -> &CellMask {
+        &self.cells
+    }
+
+    /// A [`OccupancyProbe`] of these cells.
+    pub fn probe(&self) -> OccupancyProbe<'_> {
+        OccupancyProbe {
+            blocks: self.blocks.get_or_init(|| blocks_of(&self.cells)).reader(),
+        }
+    }
+
+    /// Heap bytes of both masks (an estimate, see [`CellMask::heap_bytes`]).
+    pub fn heap_bytes(&self) -> usize {
+        self.cells.heap_bytes() + self.blocks.get().map_or(0, CellMask::heap_bytes)
+    }
+}
+
+/// Answers "may fine cell `key` hold points?" on blocks of 16 × 16 and of
+/// 4 × 4 fine cells ([`Occupancy::probe`]): `false` only when no cell of the
+/// block holds points. Remembers the words it read last, so a walk along a
+/// beam through empty space looks up one word per 32 × 32 cells.
+#[derive(Debug)]
+pub struct OccupancyProbe<'a> {
+    blocks: CellMaskReader<'a>,
+}
+
+impl OccupancyProbe<'_> {
+    /// log2 of the side \[fine cells\] of the blocks
+    /// [`OccupancyProbe::may_hold`] answers for as a whole (16 × 16).
+    pub fn block_bits(&self) -> Option<u32> {
+        Some((SMALL_BITS + WORD_BITS - 1) as u32)
+    }
+
+    /// log2 of the side \[fine cells\] of the smaller blocks
+    /// [`OccupancyProbe::may_hold_inner`] answers for (4 × 4).
+    pub fn inner_bits(&self) -> Option<u32> {
+        Some(SMALL_BITS as u32)
+    }
+
+    /// `false` only when no fine cell of `key`'s 16 × 16 block holds points.
+    #[inline]
+    pub fn may_hold(&mut self, key: CellKey) -> bool {
+        self.blocks.any_in_quarter(small_block(key))
+    }
+
+    /// `false` only when no fine cell of `key`'s 4 × 4 block holds points.
+    #[inline]
+    pub fn may_hold_inner(&mut self, key: CellKey) -> bool {
+        self.blocks.contains(small_block(key))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+    use rustc_hash::FxHashSet;
+
+    /// The blocks' bits equal those of the cells present, under random
+    /// inserts and removals (including repeated and absent keys).
+    #[test]
+    fn blocks_follow_the_cells_under_inserts_and_removals() {
+        let mut rng = StdRng::seed_from_u64(3);
+        let mut occ = Occupancy::default();
+        // The blocks are kept from the first probe on.
+        let _ = occ.probe();
+        let mut cells: FxHashSet<CellKey> = FxHashSet::default();
+        for round in 0..400 {
+            let keys: Vec<CellKey> = (0..rng.random_range(1..40))
+                .map(|_| CellKey {
+                    ix: rng.random_range(-40..40),
+                    iy: rng.random_range(-40..40),
+                })
+                .collect();
+            if round % 3 == 2 {
+                occ.remove(&keys);
+                for k in &keys {
+                    cells.remove(k);
+                }
+            } else {
+                occ.insert(&keys);
+                cells.extend(keys.iter().copied());
+            }
+            let fresh = Occupancy::of(cells.iter().copied());
+            assert_eq!(occ, fresh, "round {round}");
+            // Kept and built from the cells, the blocks are the same.
+            let _ = fresh.probe();
+            assert_eq!(occ.blocks.get(), fresh.blocks.get(), "round {round}");
+        }
+        let mut probe = occ.probe();
+        for ix in -50..50 {
+            for iy in -50..50 {
+                let key = CellKey { ix, iy };
+                let near = |bits: i32| {
+                    cells
+                        .iter()
+                        .any(|c| c.ix >> bits == ix >> bits && c.iy >> bits == iy >> bits)
+                };
+                assert_eq!(probe.may_hold(key), near(4), "{key:?}");
+                assert_eq!(probe.may_hold_inner(key), near(2), "{key:?}");
+            }
+        }
+    }
+}
