@@ -288,6 +288,30 @@ def test_bad_cell_size(bad: float) -> None:
         ndtgrid.NdtGrid(bad)
 
 
+class _Tagged(np.ndarray):
+    """An ndarray subclass: converted by ``numpy.asarray``, as other array-likes are."""
+
+
+@pytest.mark.parametrize(
+    "convert",
+    [
+        lambda a: a.view(_Tagged),
+        lambda a: np.ma.masked_array(a, mask=np.zeros_like(a, dtype=bool)),
+        lambda a: a.tolist(),
+        lambda a: np.asfortranarray(a),
+        lambda a: np.repeat(a, 2, axis=-1)[..., ::2],
+    ],
+    ids=["subclass", "masked", "list", "fortran", "strided"],
+)
+def test_array_likes_insert_as_their_ndarray(convert: Callable[[Any], Any]) -> None:
+    # Plain float64 arrays skip numpy.asarray in the binding; everything else goes
+    # through it: both must give the same map.
+    plain, other = ndtgrid.NdtGrid(0.02), ndtgrid.NdtGrid(0.02)
+    plain.insert(GOOD, POSE)
+    other.insert(convert(np.asarray(GOOD, dtype=np.float64)), convert(POSE))
+    assert same(snapshot(plain), snapshot(other))
+
+
 def test_empty_insert_is_a_no_op() -> None:
     grid = ndtgrid.NdtGrid(0.02)
     grid.insert(GOOD, POSE)

@@ -9,6 +9,7 @@ use numpy::{
 };
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyAnyMethods, PyTuple};
 
 /// `(N, 2)` float64 points, borrowed from a C-contiguous numpy array.
@@ -46,8 +47,17 @@ fn shape_text(shape: &[usize]) -> String {
 /// array-like, and with the dtype checked to be real numbers.
 fn real_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyUntypedArray>> {
     let py = obj.py();
-    let np = py.import("numpy")?;
-    let arr = np.call_method1("asarray", (obj,)).map_err(|_| {
+    // An ndarray itself (not a subclass) is what `numpy.asarray` returns for
+    // it: the common case skips the call (and `asarray` is looked up once).
+    static ASARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+    let arr = if obj.get_type().is(py.get_type::<PyUntypedArray>()) {
+        Ok(obj.clone())
+    } else {
+        ASARRAY
+            .import(py, "numpy", "asarray")
+            .and_then(|asarray| asarray.call1((obj,)))
+    };
+    let arr = arr.map_err(|_| {
         PyTypeError::new_err(format!(
             "{what}: expected an array-like of real numbers, got {}",
             obj.get_type()
@@ -75,8 +85,11 @@ fn as_f64_contiguous<'py>(arr: Bound<'py, PyUntypedArray>) -> PyResult<Bound<'py
     if is_f64 && arr.is_c_contiguous() {
         return Ok(arr.into_any());
     }
-    let np = arr.py().import("numpy")?;
-    np.call_method1("ascontiguousarray", (arr, np.getattr("float64")?))
+    static CONTIGUOUS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+    let py = arr.py();
+    CONTIGUOUS
+        .import(py, "numpy", "ascontiguousarray")?
+        .call1((arr, numpy::dtype::<f64>(py)))
 }
 
 /// Validates and borrows `(N, 2)` points named `what`.
