@@ -88,8 +88,10 @@ pub struct NdtGrid {
 }
 
 impl Clone for NdtGrid {
+    /// A copy with its coarser levels up to date (a copy made inside a
+    /// deferral brings its own up to date at once).
     fn clone(&self) -> Self {
-        Self {
+        let mut copy = Self {
             cell_size: self.cell_size,
             inv_cell_size: self.inv_cell_size,
             pyramid: self.pyramid.clone(),
@@ -102,8 +104,10 @@ impl Clone for NdtGrid {
                     .collect(),
             ),
             pending: self.pending.clone(),
-            deferring: self.deferring,
-        }
+            deferring: 1,
+        };
+        copy.end_deferral();
+        copy
     }
 }
 

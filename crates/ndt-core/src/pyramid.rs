@@ -130,7 +130,7 @@ impl Pyramid {
     /// The fine level's part of [`Pyramid::add`]: eq. (6) for the points
     /// `staged`, the occupancy and the bounds; the coarser levels are left
     /// for [`Pyramid::refresh`]. Returns the fine cells that changed.
-    pub fn add_fine(&mut self, staged: &[(CellKey, Vector2<f64>)]) -> Vec<CellKey> {
+    pub(crate) fn add_fine(&mut self, staged: &[(CellKey, Vector2<f64>)]) -> Vec<CellKey> {
         let fine = &mut self.levels[0];
         let seen = self.seen.take();
         let mut touched = Vec::with_capacity(staged.len());
@@ -175,7 +175,7 @@ impl Pyramid {
     /// bit, as after [`Pyramid::add`] and [`Pyramid::remove`] call by call
     /// (a coarse cell is a function of the fine cells alone). Returns the
     /// changed keys per level (level 0: `fine`, each once).
-    pub fn refresh(&mut self, fine: &[CellKey]) -> Vec<Vec<CellKey>> {
+    pub(crate) fn refresh(&mut self, fine: &[CellKey]) -> Vec<Vec<CellKey>> {
         let seen = self.seen.take();
         let once: Vec<CellKey> = fine.iter().copied().filter(|&k| seen.insert(k)).collect();
         self.refresh_parents(once)
@@ -235,7 +235,7 @@ impl Pyramid {
 
     /// The fine level's part of [`Pyramid::remove`] (see
     /// [`Pyramid::add_fine`]). Returns the fine cells actually removed.
-    pub fn remove_fine(&mut self, keys: &[CellKey]) -> Vec<CellKey> {
+    pub(crate) fn remove_fine(&mut self, keys: &[CellKey]) -> Vec<CellKey> {
         let seen = self.seen.take();
         let mut removed = Vec::new();
         for &key in keys {

@@ -145,6 +145,7 @@ mod tests {
             }
         }
         let mut lazy = eager.clone();
+        let mut copy_inside;
         for round in 0..12 {
             let mut ops = Vec::new();
             for _ in 0..rng.random_range(1..8) {
@@ -200,9 +201,13 @@ mod tests {
                     assert!(occupied.contains(k));
                 }
                 assert_eq!(outer.len(), eager.len(), "round {round}");
+                // A copy made inside is brought up to date at once.
+                copy_inside = NdtGrid::clone(&outer);
+                assert!(copy_inside.pending.is_empty() && copy_inside.deferring == 0);
             }
             assert!(lazy.pending.is_empty());
             assert_eq!(lazy.deferring, 0);
+            assert_same(&eager, &copy_inside);
             assert_same(&eager, &lazy);
             // The bounds grow with the inserts alike (a fresh grid's are
             // tight, so they are compared here only).
