@@ -104,7 +104,7 @@ impl Occupancy {
         &self.cells
     }
 
-    /// A [`OccupancyProbe`] of these cells.
+    /// An [`OccupancyProbe`] of these cells.
     pub fn probe(&self) -> OccupancyProbe<'_> {
         OccupancyProbe {
             blocks: self.blocks.get_or_init(|| blocks_of(&self.cells)).reader(),
