@@ -17,6 +17,22 @@ use crate::parity::ParityMemo;
 pub const BLOCK_BITS: i32 = 3;
 const MASK: i32 = (1 << BLOCK_BITS) - 1;
 
+/// The bits of a block's word for one of its quarters (squares of
+/// `2^(BLOCK_BITS − 1)` cells a side): `qx`, `qy` 0 for the lower half of
+/// the block's columns or rows, 1 for the upper.
+pub const fn quarter_mask(qx: i32, qy: i32) -> u64 {
+    const HALF: i32 = 1 << (BLOCK_BITS - 1);
+    // HALF rows of HALF bits at the block's origin.
+    let row = (1u64 << HALF) - 1;
+    let mut m = 0;
+    let mut r = 0;
+    while r < HALF {
+        m |= row << (r << BLOCK_BITS);
+        r += 1;
+    }
+    m << (((qy * HALF) << BLOCK_BITS) | (qx * HALF))
+}
+
 /// One bit per cell of a set of cells.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct CellMask {
@@ -155,20 +171,9 @@ impl CellMaskReader<'_> {
     /// `key`: the quarter's rows of the block's word.
     #[inline]
     pub fn any_in_quarter(&mut self, key: CellKey) -> bool {
-        const HALF: i32 = 1 << (BLOCK_BITS - 1);
-        // HALF rows of HALF bits at the block's origin.
-        const QUARTER: u64 = {
-            let row = (1u64 << HALF) - 1;
-            let mut m = 0;
-            let mut r = 0;
-            while r < HALF {
-                m |= row << (r << BLOCK_BITS);
-                r += 1;
-            }
-            m
-        };
-        let shift = ((key.iy & HALF) << BLOCK_BITS) | (key.ix & HALF);
-        self.word(split(key).0) & (QUARTER << shift) != 0
+        let half_x = (key.ix & MASK) >> (BLOCK_BITS - 1);
+        let half_y = (key.iy & MASK) >> (BLOCK_BITS - 1);
+        self.word(split(key).0) & quarter_mask(half_x, half_y) != 0
     }
 
     /// `true` when `key` is in the set.

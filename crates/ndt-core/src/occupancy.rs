@@ -10,11 +10,12 @@
 
 use std::sync::OnceLock;
 
-use crate::cellmask::{CellMask, CellMaskReader, BLOCK_BITS as WORD_BITS};
+use crate::cellmask::{quarter_mask, CellMask, CellMaskReader, BLOCK_BITS as WORD_BITS};
 use crate::key::CellKey;
 
-/// log2 of the side \[cells\] of the blocks with a bit each.
-const SMALL_BITS: i32 = 2;
+/// log2 of the side \[cells\] of the blocks with a bit each: a quarter of
+/// a word of the cells' mask (so a block empties when that quarter does).
+const SMALL_BITS: i32 = WORD_BITS - 1;
 
 /// The block of 4 × 4 cells holding `key`, as a key of that lattice.
 #[inline]
@@ -44,24 +45,19 @@ impl PartialEq for Occupancy {
 /// The occupied blocks of 4 × 4 cells of the cells `cells`: each word of
 /// `cells` (8 × 8 cells) gives the bits of its occupied quarters.
 fn blocks_of(cells: &CellMask) -> CellMask {
-    const HALF: i32 = 1 << (WORD_BITS - 1);
-    let quarter = |qx: i32, qy: i32| -> u64 {
-        let row = (1u64 << HALF) - 1;
-        (0..HALF).fold(0, |m, r| m | row << ((qy * HALF + r) << WORD_BITS)) << (qx * HALF)
-    };
     let mut blocks = CellMask::default();
-    let mut keys = Vec::new();
-    for ((bx, by), word) in cells.words() {
-        for (qx, qy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-            if word & quarter(qx, qy) != 0 {
-                keys.push(CellKey {
+    blocks.set_pairs(cells.words().flat_map(|((bx, by), word)| {
+        [(0, 0), (1, 0), (0, 1), (1, 1)]
+            .into_iter()
+            .filter(move |&(qx, qy)| word & quarter_mask(qx, qy) != 0)
+            .map(move |(qx, qy)| {
+                let key = CellKey {
                     ix: bx * 2 + qx,
                     iy: by * 2 + qy,
-                });
-            }
-        }
-    }
-    blocks.set_all(&keys, true);
+                };
+                (key, true)
+            })
+    }));
     blocks
 }
 
