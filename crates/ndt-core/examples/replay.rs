@@ -17,6 +17,13 @@
 //! (its distributions prepared by a match before the second insertion, as
 //! in the loop) and loses the cells of the loop's map window, as
 //! `Odometry` does; prints the time of the inserts and of the removals.
+//! `replay <dump> threads [reps]`: `speed.py`'s thread section without
+//! Python. `Odometry` (loop only) over the first 3000 scans gives poses; a
+//! 2 cm grid takes every third scan; then, `reps` times, the 3000 scans are
+//! matched from their poses moved by a fixed offset on one thread, then
+//! split alternately between two threads on that one grid, then likewise on
+//! two clones of it; prints each run's matches per second, the ratios, and
+//! whether the poses were the same.
 
 use std::collections::VecDeque;
 use std::error::Error;
@@ -229,10 +236,70 @@ fn mapwork(scans: &[Scan], reps: usize) -> Result<(), Box<dyn Error>> {
     Ok(())
 }
 
+fn threads(scans: &[Scan], reps: usize) -> Result<(), Box<dyn Error>> {
+    let scans = &scans[..scans.len().min(3000)];
+    let mut config = OdometryConfig::default();
+    (config.insert_distance, config.insert_angle) = (1e9, 1e9);
+    let mut odo = Odometry::new(config)?;
+    let mut jobs = Vec::with_capacity(scans.len());
+    for (r, a, o) in scans {
+        odo.step(r, a, *o)?;
+        let pose = odo.poses().last().copied().unwrap_or_default();
+        jobs.push((points_from_ranges(r, a, 0.0, 30.0)?, pose));
+    }
+    let mut grid = NdtGrid::new(0.02)?;
+    for (points, pose) in jobs.iter().step_by(3) {
+        grid.insert(points, *pose)?;
+    }
+    let options = MatchOptions::default();
+    let offset = Pose2::new(0.03, -0.02, 0.01);
+    let run = |grids: [&NdtGrid; 2], split: bool| -> Result<(f64, Vec<Pose2>), String> {
+        let work = |grid: &NdtGrid, part: usize| -> Result<Vec<Pose2>, String> {
+            let stride = if split { 2 } else { 1 };
+            (jobs.iter().skip(part).step_by(stride))
+                .map(|(p, g)| grid.match_scan(p, g.compose(offset), &options))
+                .map(|r| r.map(|m| m.pose).map_err(|e| e.to_string()))
+                .collect()
+        };
+        let t = Instant::now();
+        let parts = if split {
+            std::thread::scope(|s| {
+                let h = [0, 1].map(|k| s.spawn(move || work(grids[k], k)));
+                h.map(|h| h.join().unwrap_or_else(|_| Err("a thread panicked".into())))
+            })
+        } else {
+            [work(grids[0], 0), Ok(Vec::new())]
+        };
+        let rate = jobs.len() as f64 / t.elapsed().as_secs_f64();
+        let [a, b] = parts;
+        let (a, b) = (a?, b?);
+        let mut poses = Vec::with_capacity(jobs.len());
+        for k in 0..a.len() {
+            poses.push(a[k]);
+            poses.extend(b.get(k));
+        }
+        Ok((rate, poses))
+    };
+    run([&grid, &grid], false)?; // distributions built, caches warm
+    let clone = grid.clone();
+    for _ in 0..reps {
+        let (one, p1) = run([&grid, &grid], false)?;
+        let (shared, p2) = run([&grid, &grid], true)?;
+        let (clones, p3) = run([&grid, &clone], true)?;
+        println!(
+            "one {one:.0}/s, two on one grid {shared:.0}/s ({:.2}x), two on clones {clones:.0}/s ({:.2}x), same poses {}",
+            shared / one,
+            clones / one,
+            p1 == p2 && p1 == p3
+        );
+    }
+    Ok(())
+}
+
 fn main() -> Result<(), Box<dyn Error>> {
     let args: Vec<String> = std::env::args().collect();
     let usage =
-        "usage: replay <dump> odometry [reps] [inline|loop-only] | matchhash | mapwork [reps]";
+        "usage: replay <dump> odometry [reps] [inline|loop-only] | matchhash | mapwork [reps] | threads [reps]";
     let (Some(path), Some(mode)) = (args.get(1), args.get(2)) else {
         return Err(usage.into());
     };
@@ -249,6 +316,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         ),
         "matchhash" => matchhash(&scans),
         "mapwork" => mapwork(&scans, args.get(3).map_or(Ok(3), |s| s.parse())?),
+        "threads" => threads(&scans, args.get(3).map_or(Ok(7), |s| s.parse())?),
         _ => Err(usage.into()),
     }
 }
