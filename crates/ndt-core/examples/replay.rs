@@ -274,8 +274,8 @@ fn threads(scans: &[Scan], reps: usize) -> Result<(), Box<dyn Error>> {
         let [a, b] = parts;
         let (a, b) = (a?, b?);
         let mut poses = Vec::with_capacity(jobs.len());
-        for k in 0..a.len() {
-            poses.push(a[k]);
+        for (k, pose) in a.iter().enumerate() {
+            poses.push(*pose);
             poses.extend(b.get(k));
         }
         Ok((rate, poses))
