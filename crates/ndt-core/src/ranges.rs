@@ -68,8 +68,8 @@ fn points_along(
     max_range: f64,
 ) -> Vec<[f64; 2]> {
     // Room for every beam at once: collecting a filter grows the vector
-    // from a few points by doubling (6 reallocations for 180 beams, 0.6 % of
-    // the odometry loop's instructions).
+    // from a few points by doubling (6 reallocations for 180 beams, 0.5 % of
+    // the odometry loop's instructions, BENCHMARK.md "Speed", session 20).
     let mut points = Vec::with_capacity(ranges.len());
     points.extend(
         ranges
