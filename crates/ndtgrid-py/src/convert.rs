@@ -95,11 +95,11 @@ fn as_f64_contiguous<'py>(arr: Bound<'py, PyUntypedArray>) -> PyResult<Bound<'py
 /// Validates and borrows `(N, 2)` points named `what`.
 pub fn points<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Points<'py>> {
     let arr = real_array(obj, what)?;
-    let shape = arr.shape().to_vec();
+    let shape = arr.shape();
     if shape.len() != 2 || shape[1] != 2 {
         return Err(PyValueError::new_err(format!(
             "{what}: expected an array of shape (N, 2), got shape {}",
-            shape_text(&shape)
+            shape_text(shape)
         )));
     }
     let array = as_f64_contiguous(arr)?
@@ -126,11 +126,11 @@ impl Vector<'_> {
 /// Validates and borrows a 1-D array named `what`.
 pub fn vector<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Vector<'py>> {
     let arr = real_array(obj, what)?;
-    let shape = arr.shape().to_vec();
+    let shape = arr.shape();
     if shape.len() != 1 {
         return Err(PyValueError::new_err(format!(
             "{what}: expected a 1-D array, got shape {}",
-            shape_text(&shape)
+            shape_text(shape)
         )));
     }
     let array = as_f64_contiguous(arr)?
@@ -143,21 +143,24 @@ pub fn vector<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Vector<'py>>
 /// Validates a `[x, y, theta]` pose named `what`.
 pub fn pose(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 3]> {
     let arr = real_array(obj, what)?;
-    let shape = arr.shape().to_vec();
-    if shape != [3] {
+    if arr.shape() != [3] {
         return Err(PyValueError::new_err(format!(
             "{what}: expected 3 values [x, y, theta], got shape {}",
-            shape_text(&shape)
+            shape_text(arr.shape())
         )));
     }
     let arr = as_f64_contiguous(arr)?
         .cast_into::<PyArray1<f64>>()
         .map_err(|e| PyTypeError::new_err(format!("{what}: {e}")))?;
-    let ro = arr.readonly();
-    let s = ro
-        .as_slice()
-        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
-    Ok([s[0], s[1], s[2]])
+    // Read while the GIL is held, so no borrow of the array to track (the
+    // numpy crate's borrow bookkeeping is a global table's insert and
+    // removal per borrow).
+    match [0, 1, 2].map(|i| arr.get_owned([i])) {
+        [Some(x), Some(y), Some(theta)] => Ok([x, y, theta]),
+        _ => Err(PyValueError::new_err(format!(
+            "{what}: expected 3 values [x, y, theta]"
+        ))),
+    }
 }
 
 /// A `(3,)` float64 array.
