@@ -87,12 +87,11 @@ impl Occupancy {
             return;
         };
         let mut cells = self.cells.reader();
-        let emptied: Vec<CellKey> = keys
-            .iter()
-            .filter(|&&k| !cells.any_in_quarter(k))
-            .map(|&k| small_block(k))
-            .collect();
-        blocks.set_all(&emptied, false);
+        blocks.set_pairs(
+            keys.iter()
+                .filter(|&&k| !cells.any_in_quarter(k))
+                .map(|&k| (small_block(k), false)),
+        );
     }
 
     /// One bit per occupied cell.
