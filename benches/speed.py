@@ -15,8 +15,9 @@ as a Markdown table to stdout as soon as it is measured (progress goes to stderr
    of the same scan.
 3. **Odometry over the whole Intel log** (13,631 scans): ``ndtgrid.Odometry(cell_size=0.02)``
    (each run in a fresh child process, which also reports the run's peak resident memory;
-   the default loop and the loop with its mapper in line three times each, alternating,
-   each judged on its median run) against the
+   the default loop, the loop with its mapper in line and the loop with no map at all,
+   ``build_map=False``, three times each, alternating, each judged on its median run)
+   against the
    small_gicp voxel-map odometry of ``benches/datasets.py`` and KISS-ICP (when
    ``kiss-icp`` is installed), with the relation error of each. KISS-ICP at its default
    voxel, the fastest peer, runs right after each of our runs (with either prior) and is
@@ -664,14 +665,16 @@ def section_insert(args: argparse.Namespace) -> dict[str, Any]:
 # ----------------------------------------------------------------------------- 3. odometry
 
 
-def intel_child(limit: int, out_path: str, one_thread: bool) -> None:
+def intel_child(limit: int, out_path: str, one_thread: bool, poses_only: bool) -> None:
     """``--intel-child``: ``ndtgrid.Odometry`` over the Intel log in this fresh process
-    (with ``one_thread``, its mapper in line: ``background_mapper=False``); poses to
-    ``out_path`` (.npy), a JSON line of times and memory to stdout. The time ends with
-    a read of ``odo.mapper``, which waits for the mapper to take in the last scans."""
+    (with ``one_thread``, its mapper in line: ``background_mapper=False``; with
+    ``poses_only``, no map at all: ``build_map=False``); poses to ``out_path`` (.npy), a
+    JSON line of times and memory to stdout. The time ends with a read of
+    ``odo.mapper`` (when there is one), which waits for the mapper to take in the last
+    scans."""
     rss_base, _ = rss_kib()
     scans = read_benchmark_split(INTEL_SPLIT)
-    config = ndtgrid.OdometryConfig(background_mapper=not one_thread)
+    config = ndtgrid.OdometryConfig(background_mapper=not one_thread, build_map=not poses_only)
     odo = ndtgrid.Odometry(cell_size=CELL, config=config)
     spent = 0.0
     wall = time.perf_counter()
@@ -687,7 +690,7 @@ def intel_child(limit: int, out_path: str, one_thread: bool) -> None:
         spent += time.perf_counter() - t0
         n += 1
     t0 = time.perf_counter()
-    mapper_cells = len(odo.mapper.grid)
+    mapper_cells = 0 if poses_only else len(odo.mapper.grid)
     spent += time.perf_counter() - t0
     wall = time.perf_counter() - wall
     np.save(out_path, odo.poses)
@@ -871,7 +874,7 @@ def section_odometry(args: argparse.Namespace) -> dict[str, Any]:
         argv = ["--intel-child", "--intel-scans", str(args.intel_scans), "--out", path]
         # Our default loop runs `intel_runs` times, each in a fresh process, and so
         # does the loop with its mapper in line (one thread), alternating with it.
-        infos, all_poses, infos_1, all_poses_1 = [], [], [], []
+        infos, all_poses, infos_1, all_poses_1, infos_p, all_poses_p = [], [], [], [], [], []
         for k in range(args.intel_runs):
             log(f"Intel: ndtgrid.Odometry in a child process (run {k + 1}/{args.intel_runs}) ...")
             infos.append(child(argv))
@@ -879,6 +882,9 @@ def section_odometry(args: argparse.Namespace) -> dict[str, Any]:
             log("Intel: the same with the mapper in line (one thread) ...")
             infos_1.append(child([*argv, "--one-thread"]))
             all_poses_1.append(np.load(path))
+            log("Intel: the same with no map (`build_map=False`, poses only) ...")
+            infos_p.append(child([*argv, "--poses-only"]))
+            all_poses_p.append(np.load(path))
             if kiss_error is None:
                 for prior in (False, True):
                     try:
@@ -887,14 +893,17 @@ def section_odometry(args: argparse.Namespace) -> dict[str, Any]:
                         kiss_note += f" KISS-ICP (prior {prior}) failed: {exc!r}."
         info = median_info(infos)
         info_1 = median_info(infos_1)
+        info_p = median_info(infos_p)
         our_poses, poses_1 = all_poses[0], all_poses_1[0]
         repeatable = all(np.array_equal(our_poses, p) for p in all_poses)
         repeatable_1 = all(np.array_equal(poses_1, p) for p in all_poses_1)
     n = int(info["scans"])
     run_times = ", ".join(f"{float(i['seconds']):.2f}" for i in infos)
     run_times_1 = ", ".join(f"{float(i['seconds']):.2f}" for i in infos_1)
+    run_times_p = ", ".join(f"{float(i['seconds']):.2f}" for i in infos_p)
     log(f"  ndtgrid: {info['seconds']:.2f} s for {n} scans ({info_1['seconds']:.2f} s one thread)")
     same = np.array_equal(our_poses, poses_1)
+    same_p = all(np.array_equal(our_poses, p) for p in all_poses_p)
     runs = [
         OdoRun(
             "ndtgrid `Odometry(cell_size=0.02)` (defaults)",
@@ -912,7 +921,17 @@ def section_odometry(args: argparse.Namespace) -> dict[str, Any]:
             f"right after one of the default's ({run_times_1} s); poses "
             f"{'identical' if same and repeatable_1 else 'DIFFERENT'} to the default's",
         ),
+        OdoRun(
+            "ndtgrid, `build_map=False` (poses only, one thread)",
+            all_poses_p[0],
+            float(info_p["seconds"]),
+            "no map (no §V elimination, no helper): what a scan-to-map odometry like "
+            f"KISS-ICP gives; median of {len(infos_p)} runs in fresh processes, each right "
+            f"after one of the default's ({run_times_p} s); poses "
+            f"{'identical' if same_p else 'DIFFERENT'} to the default's",
+        ),
     ]
+    n_ours = len(runs)
     try:
         runs.append(run_small_gicp_odometry(scans))
     except ImportError:
@@ -986,12 +1005,13 @@ def section_odometry(args: argparse.Namespace) -> dict[str, Any]:
             f"inserted, `map_window` {ndtgrid.OdometryConfig().map_window}).",
         ]
     )
-    peers = runs[2:]
+    peers = runs[n_ours:]
     res: dict[str, Any] = {
         "scans": n,
         "ours": ours_s,
         "ours_runs": [float(i["seconds"]) for i in infos],
         "ours_one_thread": runs[1].seconds,
+        "ours_poses_only": runs[2].seconds,
         "vmhwm_mib": info["vmhwm_kib"] * mib,
     }
     if peers:
@@ -1534,7 +1554,7 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
             f"Intel log through `Odometry` ≤ 3 s ({o['scans']} scans)",
             f"{o['ours']:.2f} s ({1e3 * o['ours'] / o['scans']:.3f} ms / scan), median of "
             f"{len(o['ours_runs'])} runs: {', '.join(f'{t:.2f}' for t in o['ours_runs'])} s; "
-            f"one thread {o['ours_one_thread']:.2f} s",
+            f"one thread {o['ours_one_thread']:.2f} s; poses only {o['ours_poses_only']:.2f} s",
             o["ours"] <= 3.0 if full else None,
         )
         for key, label in (
@@ -1544,9 +1564,11 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
             if key in o:
                 name, t = o[key]
                 one = t / o["ours_one_thread"]
+                bare = t / o["ours_poses_only"]
                 row(
                     label,
-                    f"{t / o['ours']:.2f}× ({name}); one thread {one:.2f}×",
+                    f"{t / o['ours']:.2f}× ({name}); one thread {one:.2f}×; poses only "
+                    f"(`build_map=False`) {bare:.2f}×",
                     t / o["ours"] >= 3,
                 )
         if "fastest_good" not in o and "fastest" in o:
@@ -1623,6 +1645,7 @@ def main() -> int:
     )
     ap.add_argument("--intel-child", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--one-thread", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--poses-only", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--memory-child", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--out", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -1651,7 +1674,7 @@ def main() -> int:
     args.memory_copies = [1, 2] if q else [1, 2, 4, 8]
 
     if args.intel_child:
-        intel_child(args.intel_scans, args.out, args.one_thread)
+        intel_child(args.intel_scans, args.out, args.one_thread, args.poses_only)
         return 0
     if args.memory_child is not None:
         memory_child(args.memory_child)

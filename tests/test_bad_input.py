@@ -702,6 +702,11 @@ ODOMETRY_CONFIG_CASES = [
     ),
     ({"max_step_cells": np.inf}, "max_step_cells: expected a finite value > 0, got inf"),
     ({"max_step_rotation": 0.0}, "max_step_rotation: expected a finite value > 0, got 0"),
+    (
+        {"build_map": False, "match_filtered_map": True},
+        "match_filtered_map: cannot be on with build_map off: the loop would match against "
+        "a map it does not build",
+    ),
 ]
 
 

@@ -157,6 +157,29 @@ def test_background_mapper_gives_the_same_poses_and_mapper() -> None:
     assert c0 == c1 and sum(c0.values()) > 0
 
 
+def test_a_loop_without_a_map_gives_the_same_poses_and_grid() -> None:
+    truth = trajectory(40)
+    config = dict(map_window=4, insert_distance=0.02)
+    full = ndtgrid.Odometry(config=ndtgrid.OdometryConfig(**config))
+    bare = ndtgrid.Odometry(config=ndtgrid.OdometryConfig(build_map=False, **config))
+    for k, pose in enumerate(truth):
+        r, a = polar(pose, seed=k, noise=0.01)
+        full.step(r, a)
+        bare.step(r, a)
+        assert bare.last_step is not None and not bare.last_step.inserted
+    np.testing.assert_array_equal(full.poses, bare.poses)
+    assert full.insertions > 10 and bare.insertions == 0
+    assert bare.grid_insertions == full.grid_insertions > 0
+    assert bare.grid().to_bytes() == full.grid().to_bytes()
+    assert len(full.mapper.grid) > 0
+    with pytest.raises(RuntimeError) as err:
+        bare.mapper  # noqa: B018
+    assert str(err.value) == (
+        "this odometry builds no map (build_map is off): it keeps the poses and the grid "
+        "it matches against only"
+    )
+
+
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="os.fork is POSIX only")
 def test_forked_child_has_the_whole_mapper_and_goes_on() -> None:
     truth = trajectory(30)

@@ -1032,6 +1032,7 @@ class OdometryLoop:
         radial_confirmation: bool | None = None,
         match_filtered_map: bool | None = None,
         background_mapper: bool | None = None,
+        build_map: bool | None = None,
     ) -> None: ...
     def step(
         self, ranges: ArrayLike, angles: ArrayLike, odom: ArrayLike | None = None
@@ -1061,7 +1062,7 @@ class OdometryLoop:
         """Wait until a background mapper has taken in every inserted scan."""
     def mapper(self) -> Mapper:
         """A copy of the mapper (grid and §V filter state), once a background mapper
-        has taken in every inserted scan."""
+        has taken in every inserted scan; ``RuntimeError`` when ``build_map`` is off."""
     def config(self) -> dict[str, Any]:
         """The settings in force, as keyword arguments (plus ``cell_size``)."""
 

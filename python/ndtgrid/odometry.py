@@ -179,6 +179,16 @@ class OdometryConfig:
         waits for it. Poses and mapper are the same bit for bit either way; it uses a
         second core (Intel log on 2 cores: BENCHMARK.md, "Speed"). Ignored with
         ``match_filtered_map``.
+    build_map : bool, default True
+        Build the map (:attr:`Odometry.mapper`) at all. ``False``: poses only, as a
+        scan-to-map odometry such as KISS-ICP gives them. The loop keeps the grid it
+        matches against (:meth:`Odometry.grid`) and nothing else: no helper thread, no
+        §V elimination; ``insert_distance``, ``insert_angle``, ``map_window`` and the
+        §V settings go unused, and :attr:`Odometry.mapper` raises ``RuntimeError``. The
+        poses are the same bit for bit (they never depend on the map unless
+        ``match_filtered_map``, which needs it: ``ValueError``). On the Intel log it
+        takes about 40 % of the default's CPU time, both threads counted, and 65-80 % of
+        its wall time (``BENCHMARK.md``, "Speed", session 21).
     """
 
     min_range: float = 0.0
@@ -220,6 +230,7 @@ class OdometryConfig:
     radial_confirmation: bool = True
     match_filtered_map: bool = False
     background_mapper: bool = True
+    build_map: bool = True
 
 
 #: Every live :class:`Odometry`, so that a fork waits for their mappers first.
@@ -361,7 +372,7 @@ class Odometry:
 
     @property
     def insertions(self) -> int:
-        """Scans added to the map so far."""
+        """Scans added to the map so far (0 without ``build_map``)."""
         return int(self._loop.insertions)
 
     @property
@@ -385,6 +396,11 @@ class Odometry:
         A copy as of this access: later steps do not change it, and changing it does
         not change the loop. With ``background_mapper`` (the default) this first waits
         until the helper thread has taken in every inserted scan.
+
+        Raises
+        ------
+        RuntimeError
+            If the loop builds no map (``OdometryConfig(build_map=False)``).
         """
         mapper: Mapper = self._loop.mapper()
         return mapper

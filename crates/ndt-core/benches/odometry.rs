@@ -94,7 +94,7 @@ fn bench_step_with(
             |o| {
                 let out = o.step(black_box(&r), black_box(&a), Some(odom));
                 // Waits for a mapper behind the loop (at once in line).
-                black_box(o.mapper().grid().len());
+                black_box(o.mapper().map(|m| m.grid().len()).ok());
                 out
             },
             BatchSize::LargeInput,

@@ -133,7 +133,9 @@ fn main() {
         odo.step(&r, &a, Some(pose(k).compose(drift)))
             .unwrap_or_else(|e| panic!("odometry scan {k}: {e}"));
         if k % every == 0 || k == odo_scans {
-            let m = odo.mapper();
+            let m = odo
+                .mapper()
+                .unwrap_or_else(|e| panic!("odometry scan {k}: {e}"));
             log.sample(
                 "odometry",
                 k,

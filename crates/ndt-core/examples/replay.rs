@@ -1,9 +1,10 @@
 //! Profiling harness: a log's scans from a dump of `benches/dump_scans.py`.
 //!
-//! `replay <dump> odometry [reps] [inline|loop-only]`: `Odometry` (default
-//! configuration; `inline`: `background_mapper: false`; `loop-only`: the
-//! mapper takes the first scan only, so the loop runs without a mapper's
-//! work beside it, with the same poses) over every scan, `reps` times;
+//! `replay <dump> odometry [reps] [inline|loop-only|poses-only]`: `Odometry`
+//! (default configuration; `inline`: `background_mapper: false`;
+//! `loop-only`: the mapper takes the first scan only, so the loop runs
+//! without a mapper's work beside it, with the same poses; `poses-only`:
+//! `build_map: false`, no mapper at all, hash 0) over every scan, `reps` times;
 //! prints the time per scan, the last pose and a hash of the mapper (every
 //! pyramid level's sums and the §V filter's records), so two builds can be
 //! compared for bit-identical maps.
@@ -93,6 +94,7 @@ fn odometry(scans: &[Scan], reps: usize, variant: Option<&str>) -> Result<(), Bo
         config.insert_distance = 1e9;
         config.insert_angle = 1e9;
     }
+    config.build_map = variant != Some("poses-only");
     for _ in 0..reps {
         let mut odo = Odometry::new(config)?;
         let t = Instant::now();
@@ -103,7 +105,10 @@ fn odometry(scans: &[Scan], reps: usize, variant: Option<&str>) -> Result<(), Bo
         let cpu = thread_cpu() - cpu;
         // Wait for the mapper (behind the loop by default) to take in the
         // last scans: part of the run.
-        let cells = odo.mapper().grid().len();
+        let map = odo.mapper().ok();
+        let cells = map.as_ref().map_or(0, |m| m.grid().len());
+        let hash = map.as_ref().map_or(0, |m| mapper_hash(m));
+        drop(map);
         let s = t.elapsed().as_secs_f64();
         let helper = process_cpu() - all - cpu;
         let last = odo.poses().last().copied().unwrap_or_default();
@@ -112,7 +117,7 @@ fn odometry(scans: &[Scan], reps: usize, variant: Option<&str>) -> Result<(), Bo
             scans.len(),
             1e3 * s / scans.len() as f64,
             odo.insertions(),
-            mapper_hash(&odo.mapper()),
+            hash,
             last.x,
             last.y,
             last.theta
@@ -299,7 +304,7 @@ fn threads(scans: &[Scan], reps: usize) -> Result<(), Box<dyn Error>> {
 fn main() -> Result<(), Box<dyn Error>> {
     let args: Vec<String> = std::env::args().collect();
     let usage =
-        "usage: replay <dump> odometry [reps] [inline|loop-only] | matchhash | mapwork [reps] | threads [reps]";
+        "usage: replay <dump> odometry [reps] [inline|loop-only|poses-only] | matchhash | mapwork [reps] | threads [reps]";
     let (Some(path), Some(mode)) = (args.get(1), args.get(2)) else {
         return Err(usage.into());
     };
@@ -310,7 +315,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             args.get(3).map_or(Ok(1), |s| s.parse())?,
             match args.get(4).map(String::as_str) {
                 None => None,
-                Some(v @ ("inline" | "loop-only")) => Some(v),
+                Some(v @ ("inline" | "loop-only" | "poses-only")) => Some(v),
                 Some(_) => return Err(usage.into()),
             },
         ),

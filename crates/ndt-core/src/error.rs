@@ -62,6 +62,23 @@ pub enum NdtError {
         /// The value that came.
         value: f64,
     },
+    /// Two options that cannot hold together.
+    #[error("{name}: cannot be on with {other} off: {reason}")]
+    ConflictingOptions {
+        /// The option that needs the other, as users spell it.
+        name: &'static str,
+        /// The option it needs.
+        other: &'static str,
+        /// Why, in words.
+        reason: &'static str,
+    },
+    /// The odometry's map was asked for, but the loop builds none
+    /// ([`crate::OdometryConfig::build_map`] off).
+    #[error(
+        "this odometry builds no map (build_map is off): it keeps the poses and the grid it \
+         matches against only"
+    )]
+    NoMap,
     /// A stored cell (see [`crate::NdtGrid::from_cell_states`]) that no grid
     /// can hold.
     #[error("cells: cell {index} {reason}")]

@@ -238,6 +238,16 @@ pub struct OdometryConfig {
     /// [`OdometryConfig::match_filtered_map`] (the loop then matches against
     /// the mapper's grid, so it must be up to date).
     pub background_mapper: bool,
+    /// Build the map at all ([`Odometry::mapper`]). Off: poses only, as a
+    /// scan-to-map odometry such as KISS-ICP gives them. The loop keeps its
+    /// matching grid and nothing else (no helper thread, no §V elimination,
+    /// `insert_distance`, `insert_angle`, `map_window` and the mapper
+    /// options unused); the poses are the same bit for bit, since they never
+    /// depend on the map ([`OdometryConfig::match_filtered_map`] aside,
+    /// which needs it). On the Intel log it takes about 40 % of the default's
+    /// CPU time, both threads counted, and 65–80 % of its wall time
+    /// (BENCHMARK.md, "Speed", session 21).
+    pub build_map: bool,
 }
 
 impl Default for OdometryConfig {
@@ -274,6 +284,7 @@ impl Default for OdometryConfig {
             },
             match_filtered_map: false,
             background_mapper: true,
+            build_map: true,
         }
     }
 }
@@ -342,6 +353,13 @@ impl OdometryConfig {
                     value: f64::from(l),
                 });
             }
+        }
+        if self.match_filtered_map && !self.build_map {
+            return Err(NdtError::ConflictingOptions {
+                name: "match_filtered_map",
+                other: "build_map",
+                reason: "the loop would match against a map it does not build",
+            });
         }
         self.matcher.validate()
     }
@@ -422,7 +440,7 @@ impl Odometry {
             grid: NdtGrid::new(config.cell_size)?,
             mapper: MapperHost::new(
                 Mapper::new(config.cell_size, mapper_options)?,
-                config.background_mapper && !config.match_filtered_map,
+                config.background_mapper && config.build_map && !config.match_filtered_map,
             )?,
             config,
             poses: Vec::new(),
@@ -455,9 +473,13 @@ impl Odometry {
     /// The mapper (grid and §V filter) the loop builds: the map to show and
     /// navigate with. With [`OdometryConfig::background_mapper`] this waits
     /// until the helper has taken in every inserted scan, and the helper
-    /// waits while the view is held.
-    pub fn mapper(&self) -> MapperView<'_> {
-        self.mapper.view()
+    /// waits while the view is held. Fails with [`NdtError::NoMap`] when
+    /// [`OdometryConfig::build_map`] is off.
+    pub fn mapper(&self) -> Result<MapperView<'_>> {
+        if !self.config.build_map {
+            return Err(NdtError::NoMap);
+        }
+        Ok(self.mapper.view())
     }
 
     /// Waits until the mapper has taken in every inserted scan (with
@@ -474,7 +496,8 @@ impl Odometry {
         &self.poses
     }
 
-    /// Scans added to the map so far.
+    /// Scans added to the map so far (0 without
+    /// [`OdometryConfig::build_map`]).
     pub fn insertions(&self) -> u64 {
         self.window.scans()
     }
@@ -712,7 +735,7 @@ impl Odometry {
             multi_start = best.multi_start;
             matched = Some(best.res);
         }
-        let inserted = !points.is_empty() && self.should_insert(pose);
+        let inserted = self.config.build_map && !points.is_empty() && self.should_insert(pose);
         let into_grid = !points.is_empty() && self.grid_takes(pose);
         self.insert_points(&points, ranges, angles, pose, inserted, into_grid)?;
         // Nothing below can fail: the loop changes only now.
@@ -736,11 +759,14 @@ impl Odometry {
 
     /// Adds a scan seen from `pose` to the map and to the matching grid
     /// (insertions, then the memory bounds), as [`Odometry::step`] does when
-    /// both policies take a scan. All-or-nothing: on error neither changes.
+    /// both policies take a scan (the matching grid only, without
+    /// [`OdometryConfig::build_map`]). All-or-nothing: on error neither
+    /// changes.
     pub fn update_map(&mut self, ranges: &[f64], angles: &[f64], pose: Pose2) -> Result<()> {
         let points = self.valid_points(ranges, angles)?;
         let into_grid = !self.config.match_filtered_map;
-        self.insert_points(&points, ranges, angles, pose, true, into_grid)
+        let to_map = self.config.build_map;
+        self.insert_points(&points, ranges, angles, pose, to_map, into_grid)
     }
 
     /// [`Odometry::update_map`] with the scan's valid points already taken

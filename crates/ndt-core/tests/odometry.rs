@@ -120,7 +120,7 @@ fn the_matching_grid_takes_the_scans_its_own_policy_picks() {
     }
     // The mapper took the other added scans too: its grid has cells the
     // matching grid lacks.
-    let mapper = odo.mapper();
+    let mapper = odo.mapper().unwrap();
     let mapped = mapper.grid();
     assert!(mapped.keys().any(|k| grid.stats(k).is_none()));
 }
@@ -171,7 +171,7 @@ fn mapper_behind_the_loop_equals_the_mapper_in_line() {
             assert!(odo.update_map(&r, &a[1..], truth).is_err());
             if i % 7 == 0 {
                 // Views nest (also on one thread) and agree.
-                let (first, second) = (odo.mapper(), odo.mapper());
+                let (first, second) = (odo.mapper().unwrap(), odo.mapper().unwrap());
                 assert_eq!(first.grid().len(), second.grid().len());
                 snapshots.push(first.to_bytes().unwrap());
             }
@@ -183,9 +183,9 @@ fn mapper_behind_the_loop_equals_the_mapper_in_line() {
         let mut copy = copy.unwrap();
         let (r, a) = square_scan(Pose2::new(0.3, 0.1, 0.1), 361);
         copy.update_map(&r, &a, Pose2::new(0.3, 0.1, 0.1)).unwrap();
-        snapshots.push(copy.mapper().to_bytes().unwrap());
-        snapshots.push(odo.mapper().to_bytes().unwrap());
-        let counts = odo.mapper().removal_counts();
+        snapshots.push(copy.mapper().unwrap().to_bytes().unwrap());
+        snapshots.push(odo.mapper().unwrap().to_bytes().unwrap());
+        let counts = odo.mapper().unwrap().removal_counts();
         (odo.poses().to_vec(), snapshots, counts)
     };
     let (inline, behind) = (run(false), run(true));
@@ -231,7 +231,10 @@ fn the_loops_mapper_equals_a_mapper_fed_the_same_scans() {
         }
     }
     assert!(odo.insertions() > 10, "{}", odo.insertions());
-    assert_eq!(odo.mapper().to_bytes().unwrap(), mapper.to_bytes().unwrap());
+    assert_eq!(
+        odo.mapper().unwrap().to_bytes().unwrap(),
+        mapper.to_bytes().unwrap()
+    );
 }
 
 /// Ranges and angles of a 361-beam, 180° scan of the room of the shared
@@ -382,4 +385,69 @@ fn a_young_sparse_map_accepts_converged_matches_so_the_loop_starts() {
         assert!(insertions >= 10, "{insertions}");
         assert!(error < 0.02, "{error}");
     }
+}
+
+/// `build_map: false` (poses only): the same poses and matching grid, bit for
+/// bit, as the default loop on the same scans (one of them handed over by
+/// `update_map`), no insertion into a map, and the map asked for is an error.
+#[test]
+fn a_loop_without_a_map_gives_the_same_poses_and_grid() {
+    let with_map = OdometryConfig {
+        insert_distance: 0.03,
+        ..OdometryConfig::default()
+    };
+    let mut full = Odometry::new(with_map).unwrap();
+    let mut bare = Odometry::new(OdometryConfig {
+        build_map: false,
+        ..with_map
+    })
+    .unwrap();
+    for i in 0..24 {
+        let t = f64::from(i);
+        let (r, a) = square_scan(Pose2::new(0.02 * t, 0.01 * t, 0.01 * t), 181);
+        let (s_full, s_bare) = (
+            full.step(&r, &a, None).unwrap(),
+            bare.step(&r, &a, None).unwrap(),
+        );
+        assert_eq!(s_full.pose, s_bare.pose, "scan {i}");
+        assert!(!s_bare.inserted);
+        if i == 17 {
+            let at = Pose2::new(0.3, 0.1, 0.1);
+            let (r, a) = square_scan(at, 97);
+            full.update_map(&r, &a, at).unwrap();
+            bare.update_map(&r, &a, at).unwrap();
+        }
+    }
+    assert_eq!(full.poses(), bare.poses());
+    assert!(full.insertions() > 10, "{}", full.insertions());
+    assert_eq!(bare.insertions(), 0);
+    assert_eq!(full.grid_insertions(), bare.grid_insertions());
+    assert_eq!(
+        full.grid().to_bytes().unwrap(),
+        bare.grid().to_bytes().unwrap()
+    );
+    assert!(full.mapper().is_ok());
+    let err = bare.mapper().err().unwrap();
+    assert_eq!(err, NdtError::NoMap);
+    assert_eq!(
+        err.to_string(),
+        "this odometry builds no map (build_map is off): it keeps the poses and the grid it \
+         matches against only"
+    );
+}
+
+#[test]
+fn a_filtered_map_needs_a_map() {
+    let err = Odometry::new(OdometryConfig {
+        build_map: false,
+        match_filtered_map: true,
+        ..OdometryConfig::default()
+    })
+    .err()
+    .unwrap();
+    assert_eq!(
+        err.to_string(),
+        "match_filtered_map: cannot be on with build_map off: the loop would match against a \
+         map it does not build"
+    );
 }

@@ -4,13 +4,14 @@ use ndt_core::NdtError;
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
 use pyo3::PyErr;
 
-/// Every [`NdtError`] but a failed file operation and a lost mapper is bad
+/// Every [`NdtError`] but a failed file operation and a lost or absent mapper is bad
 /// input: a `ValueError` carrying the core's message, which names the
 /// argument (or the file), what was expected and what came. A failed file
 /// operation is an `OSError` with the error number, so that Python picks the
 /// subclass (`FileNotFoundError`, `IsADirectoryError`, ...), and the file
-/// name. An odometry's mapper that lost scans across a fork is a
-/// `RuntimeError`: nothing the caller passed was wrong.
+/// name. An odometry's mapper that lost scans across a fork, or asked of a
+/// loop that builds none, is a `RuntimeError`: nothing the call passed was
+/// wrong.
 pub fn to_py(err: NdtError) -> PyErr {
     match err {
         NdtError::Io {
@@ -20,7 +21,7 @@ pub fn to_py(err: NdtError) -> PyErr {
             message,
         } => PyOSError::new_err((errno, format!("cannot {action}: {message}"), path)),
         NdtError::Io { .. } => PyOSError::new_err(err.to_string()),
-        NdtError::MapperLost { .. } => PyRuntimeError::new_err(err.to_string()),
+        NdtError::MapperLost { .. } | NdtError::NoMap => PyRuntimeError::new_err(err.to_string()),
         other => PyValueError::new_err(other.to_string()),
     }
 }

@@ -120,7 +120,7 @@ impl PyOdometry {
         freeze_unconstrained = None, freeze_ratio = None, coarse_model = None,
         outlier_filter = None, edge_removal = None, backshift_rejection = None,
         observation_check = None, radial_confirmation = None, match_filtered_map = None,
-        background_mapper = None
+        background_mapper = None, build_map = None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -164,6 +164,7 @@ impl PyOdometry {
         radial_confirmation: Option<bool>,
         match_filtered_map: Option<bool>,
         background_mapper: Option<bool>,
+        build_map: Option<bool>,
     ) -> PyResult<Self> {
         let d = OdometryConfig::default();
         let m = d.matcher;
@@ -235,6 +236,7 @@ impl PyOdometry {
             },
             match_filtered_map: match_filtered_map.unwrap_or(d.match_filtered_map),
             background_mapper: background_mapper.unwrap_or(d.background_mapper),
+            build_map: build_map.unwrap_or(d.build_map),
         };
         Ok(Self {
             inner: Mutex::new(Odometry::new(config).map_err(to_py)?),
@@ -305,7 +307,9 @@ impl PyOdometry {
 
     /// A copy of the mapper (grid and §V filter state) as of this call.
     fn mapper(&self, py: Python<'_>) -> PyResult<crate::mapper::PyMapper> {
-        let mapper = self.with(py, |o| o.mapper().clone())?;
+        let mapper = self
+            .with(py, |o| o.mapper().map(|m| ndt_core::Mapper::clone(&m)))?
+            .map_err(to_py)?;
         crate::mapper::PyMapper::from_core(py, mapper)
     }
 
@@ -358,6 +362,7 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     out.set_item("radial_confirmation", c.mapper.radial_confirmation)?;
     out.set_item("match_filtered_map", c.match_filtered_map)?;
     out.set_item("background_mapper", c.background_mapper)?;
+    out.set_item("build_map", c.build_map)?;
     Ok(out)
 }
 
