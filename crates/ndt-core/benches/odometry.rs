@@ -10,6 +10,8 @@
 //! helper to take the scan in: one isolated step cannot overlap the two, so
 //! this is the step's latency with the hand-over, not the loop's throughput
 //! (for that, the whole Intel log: `examples/replay.rs`, `benches/speed.py`).
+//! `181_beams_2cm_poses_only` builds no map (`build_map: false`): the step
+//! matches and feeds the matching grid only.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -37,12 +39,14 @@ fn path(k: u32) -> Pose2 {
 
 fn bench_step(c: &mut Criterion) {
     let mut group = c.benchmark_group("odometry_step");
-    for (name, background_mapper) in [
-        ("181_beams_2cm", false),
-        ("181_beams_2cm_mapper_behind", true),
+    for (name, background_mapper, build_map) in [
+        ("181_beams_2cm", false, true),
+        ("181_beams_2cm_mapper_behind", true, true),
+        ("181_beams_2cm_poses_only", false, false),
     ] {
         let config = OdometryConfig {
             background_mapper,
+            build_map,
             ..OdometryConfig::default()
         };
         bench_step_with(&mut group, name, config);
@@ -63,7 +67,7 @@ fn bench_step_with(
             .unwrap_or_else(|e| panic!("{e}"));
     }
     // The measured step: the next scan from the 61st on whose step adds it
-    // to the map and to the matching grid (a step that only matches would
+    // to the map (if it builds one) and to the matching grid (a step that only matches would
     // measure less than the loop does on average); the scans before it are
     // processed first.
     let scan = |k: u32| {
@@ -79,7 +83,7 @@ fn bench_step_with(
             .step(&r, &a, Some(odom))
             .unwrap_or_else(|e| panic!("{e}"))
             .inserted;
-        if inserted && probe.grid_insertions() > odo.grid_insertions() {
+        if (inserted || !config.build_map) && probe.grid_insertions() > odo.grid_insertions() {
             break;
         }
         assert!(k < 70, "no step of scans 60-69 inserts into both maps");
