@@ -256,6 +256,16 @@ pub trait DistLookup {
     type Dist: std::borrow::Borrow<Gaussian> + Copy;
     /// The distribution of cell `key`, if it has one.
     fn get(&mut self, key: CellKey) -> Option<Self::Dist>;
+    /// Calls `f` with the distribution of each of the 8 cells around `key`
+    /// that has one, in the order of [`crate::table::RING1`].
+    #[inline(always)]
+    fn for_ring1(&mut self, key: CellKey, mut f: impl FnMut(Self::Dist)) {
+        for (dx, dy) in crate::table::RING1 {
+            if let Some(g) = self.get(key.offset(dx, dy)) {
+                f(g);
+            }
+        }
+    }
 }
 
 /// Code run with the reader of [`Distributions`] of whichever kind they are
@@ -288,6 +298,10 @@ impl<'a> DistLookup for OwnCursor<'a> {
     fn get(&mut self, key: CellKey) -> Option<&'a Gaussian> {
         self.0.get(key).map(|l| &l.0)
     }
+    #[inline(always)]
+    fn for_ring1(&mut self, key: CellKey, mut f: impl FnMut(&'a Gaussian)) {
+        self.0.for_ring1(key, |l| f(&l.0));
+    }
 }
 
 impl DistLookup for ShapedCursor<'_> {
@@ -295,6 +309,10 @@ impl DistLookup for ShapedCursor<'_> {
     #[inline(always)]
     fn get(&mut self, key: CellKey) -> Option<Gaussian> {
         ShapedCursor::get(self, key)
+    }
+    #[inline(always)]
+    fn for_ring1(&mut self, key: CellKey, f: impl FnMut(Gaussian)) {
+        ShapedCursor::for_ring1(self, key, f);
     }
 }
 

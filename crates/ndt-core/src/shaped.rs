@@ -235,13 +235,31 @@ impl ShapedCursor<'_> {
     #[inline(always)]
     pub fn get(&mut self, key: CellKey) -> Option<Gaussian> {
         let e = self.cells.get(key)?;
-        let p = self.parts.get(e.part as usize)?;
-        Some(Gaussian {
-            mean: e.mean,
-            inverse: p.inverse,
-            normal: p.normal,
-        })
+        assemble(self.parts, e)
     }
+
+    /// Calls `f` with the distribution of each of the 8 cells around `key`
+    /// that has one (see [`crate::table::Cursor::for_ring1`]).
+    #[inline(always)]
+    pub fn for_ring1(&mut self, key: CellKey, mut f: impl FnMut(Gaussian)) {
+        let parts = self.parts;
+        self.cells.for_ring1(key, |e| {
+            if let Some(g) = assemble(parts, e) {
+                f(g);
+            }
+        });
+    }
+}
+
+/// The distribution of a cell's entry: its mean with its part's covariance.
+#[inline(always)]
+fn assemble(parts: &[Part], e: &Entry) -> Option<Gaussian> {
+    let p = parts.get(e.part as usize)?;
+    Some(Gaussian {
+        mean: e.mean,
+        inverse: p.inverse,
+        normal: p.normal,
+    })
 }
 
 #[cfg(test)]

@@ -24,6 +24,20 @@ const MASK: i32 = TILE - 1;
 /// No value in this slot.
 const EMPTY: u32 = u32::MAX;
 
+/// The 8 offsets `(dx, dy)` of the ring at Chebyshev distance 1 in the order
+/// the §IV-A(1) neighbour search takes them ([`crate::neighbor`]): that
+/// order breaks ties between equally near means.
+pub const RING1: [(i32, i32); 8] = [
+    (-1, -1),
+    (-1, 1),
+    (0, -1),
+    (0, 1),
+    (1, -1),
+    (1, 1),
+    (-1, 0),
+    (1, 0),
+];
+
 type Tile = [u32; (TILE * TILE) as usize];
 
 /// Tile index and slot within the tile of `key`.
@@ -439,6 +453,37 @@ impl<'a, T> Cursor<'a, T> {
         out
     }
 
+    /// Calls `f` with the value of each of the 8 cells around `key` that
+    /// has one (the ring at Chebyshev distance 1 of the §IV-A(1) neighbour
+    /// search), in the order of [`RING1`]. Inside its tile (36 of a tile's
+    /// 64 cells) the ring is read from that tile's slots at fixed offsets,
+    /// with one tile look-up; else cell by cell (reading the 2 × 2 tiles at
+    /// once as [`Cursor::block3`] does cost more there).
+    #[inline(always)]
+    pub fn for_ring1(&mut self, key: CellKey, mut f: impl FnMut(&'a T)) {
+        let (sx, sy) = (key.ix & MASK, key.iy & MASK);
+        if sx > 0 && sy > 0 && sx < MASK && sy < MASK {
+            let (tile, slot) = split(key);
+            let Some(slots) = self.tile_slots(tile) else {
+                return;
+            };
+            let values = &self.table.values;
+            for (dx, dy) in RING1 {
+                let s = slot.wrapping_add_signed((dy * TILE + dx) as isize);
+                // An empty slot (`EMPTY`) is out of the values' range.
+                if let Some(v) = slots.get(s).and_then(|&i| values.get(i as usize)) {
+                    f(v);
+                }
+            }
+            return;
+        }
+        for (dx, dy) in RING1 {
+            if let Some(v) = self.get(key.offset(dx, dy)) {
+                f(v);
+            }
+        }
+    }
+
     /// The values of the 4 cells of this level under cell `parent` of the
     /// level above (keys `2 · parent + (0|1, 0|1)`), in the order (0, 0),
     /// (1, 0), (0, 1), (1, 1), `none` for a cell without one. The 4 always
@@ -538,13 +583,20 @@ mod tests {
                 assert_eq!(cursor.get(key), naive.get(&key));
             }
         }
-        // Blocks and quads read what single look-ups read, inside tiles,
-        // across their borders and where no tile is.
+        // Rings, blocks and quads read what single look-ups read, inside
+        // tiles, across their borders and where no tile is.
         let mut blocks = table.cursor();
         let none = -1;
         for ix in -22..22 {
             for iy in -20..20 {
                 let key = CellKey { ix, iy };
+                let mut ring = Vec::new();
+                blocks.for_ring1(key, |v| ring.push(*v));
+                let want: Vec<i32> = RING1
+                    .iter()
+                    .filter_map(|&(dx, dy)| naive.get(&key.offset(dx, dy)).copied())
+                    .collect();
+                assert_eq!(ring, want, "{key:?}");
                 let block = blocks.block3(key, &none);
                 for (i, got) in block.iter().enumerate() {
                     let n = key.offset((i % 3) as i32 - 1, (i / 3) as i32 - 1);
