@@ -872,8 +872,9 @@ def section_odometry(args: argparse.Namespace) -> dict[str, Any]:
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "poses.npy")
         argv = ["--intel-child", "--intel-scans", str(args.intel_scans), "--out", path]
-        # Our default loop runs `intel_runs` times, each in a fresh process, and so
-        # does the loop with its mapper in line (one thread), alternating with it.
+        # Our default loop runs `intel_runs` times, each in a fresh process, and so do
+        # the loop with its mapper in line (one thread) and the loop with no map,
+        # alternating with it.
         infos, all_poses, infos_1, all_poses_1, infos_p, all_poses_p = [], [], [], [], [], []
         for k in range(args.intel_runs):
             log(f"Intel: ndtgrid.Odometry in a child process (run {k + 1}/{args.intel_runs}) ...")

@@ -187,8 +187,8 @@ class OdometryConfig:
         §V settings go unused, and :attr:`Odometry.mapper` raises ``RuntimeError``. The
         poses are the same bit for bit (they never depend on the map unless
         ``match_filtered_map``, which needs it: ``ValueError``). On the Intel log it
-        takes about 40 % of the default's CPU time, both threads counted, and 65-80 % of
-        its wall time (``BENCHMARK.md``, "Speed", session 21).
+        used 37-43 % of the default's CPU time, both threads counted, and 64-94 % of its
+        wall time (``BENCHMARK.md``, "Speed", session 21).
     """
 
     min_range: float = 0.0

@@ -168,7 +168,7 @@ mod tests {
     /// On a map of scattered clusters (cells inside tiles, on their borders
     /// and where no tile is), both kinds of store give the reference's
     /// distribution and count for every point, on the fine level and a
-    /// coarser one, with radii 1 to 3. Points on a lattice of means tie.
+    /// coarser one, with radii 1 to 3.
     #[test]
     fn ring_search_is_the_rule_on_both_stores() {
         let mut rng = StdRng::seed_from_u64(11);

@@ -244,8 +244,8 @@ pub struct OdometryConfig {
     /// `insert_distance`, `insert_angle`, `map_window` and the mapper
     /// options unused); the poses are the same bit for bit, since they never
     /// depend on the map ([`OdometryConfig::match_filtered_map`] aside,
-    /// which needs it). On the Intel log it takes about 40 % of the default's
-    /// CPU time, both threads counted, and 65–80 % of its wall time
+    /// which needs it). On the Intel log it used 37–43 % of the default's
+    /// CPU time, both threads counted, and 64–94 % of its wall time
     /// (BENCHMARK.md, "Speed", session 21).
     pub build_map: bool,
 }

@@ -4,9 +4,9 @@ use ndt_core::NdtError;
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
 use pyo3::PyErr;
 
-/// Every [`NdtError`] but a failed file operation and a lost or absent mapper is bad
-/// input: a `ValueError` carrying the core's message, which names the
-/// argument (or the file), what was expected and what came. A failed file
+/// Every [`NdtError`] but a failed file operation and a lost or absent
+/// mapper is bad input: a `ValueError` carrying the core's message, which
+/// names the argument (or the file), what was expected and what came. A failed file
 /// operation is an `OSError` with the error number, so that Python picks the
 /// subclass (`FileNotFoundError`, `IsADirectoryError`, ...), and the file
 /// name. An odometry's mapper that lost scans across a fork, or asked of a
