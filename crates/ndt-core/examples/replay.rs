@@ -107,10 +107,11 @@ fn odometry(scans: &[Scan], reps: usize, variant: Option<&str>) -> Result<(), Bo
         // last scans: part of the run.
         let map = odo.mapper().ok();
         let cells = map.as_ref().map_or(0, |m| m.grid().len());
-        let hash = map.as_ref().map_or(0, |m| mapper_hash(m));
-        drop(map);
         let s = t.elapsed().as_secs_f64();
         let helper = process_cpu() - all - cpu;
+        // Not part of the run.
+        let hash = map.as_ref().map_or(0, |m| mapper_hash(m));
+        drop(map);
         let last = odo.poses().last().copied().unwrap_or_default();
         println!(
             "{} scans {s:.3} s ({cpu:.2} s CPU on the loop's thread, {helper:.2} s on others) {:.4} ms/scan, {} inserted, {cells} mapper cells (hash {:016x}), last pose {:.12} {:.12} {:.12}",
@@ -243,9 +244,10 @@ fn mapwork(scans: &[Scan], reps: usize) -> Result<(), Box<dyn Error>> {
 
 fn threads(scans: &[Scan], reps: usize) -> Result<(), Box<dyn Error>> {
     let scans = &scans[..scans.len().min(3000)];
-    let mut config = OdometryConfig::default();
-    (config.insert_distance, config.insert_angle) = (1e9, 1e9);
-    let mut odo = Odometry::new(config)?;
+    let mut odo = Odometry::new(OdometryConfig {
+        build_map: false,
+        ..OdometryConfig::default()
+    })?;
     let mut jobs = Vec::with_capacity(scans.len());
     for (r, a, o) in scans {
         odo.step(r, a, *o)?;

@@ -114,6 +114,17 @@ mod tests {
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
 
+    /// `k = 10` and a 5 mm σ floor; cells finer than `shape_cell` \[m\]
+    /// take their ancestor's covariance (0: each keeps its own).
+    fn options(shape_cell: f64, fuse_minority: bool) -> DistOptions {
+        DistOptions {
+            expansion: 10.0,
+            fuse_minority,
+            sigma_floor: 0.005,
+            shape_cell,
+        }
+    }
+
     /// The search through a store's own reader (its ring read at once).
     struct Search {
         point: Vector2<f64>,
@@ -190,12 +201,7 @@ mod tests {
             .collect();
         let mut searched = 0;
         for shape_cell in [0.0, 0.32] {
-            let options = DistOptions {
-                expansion: 10.0,
-                fuse_minority: true,
-                sigma_floor: 0.005,
-                shape_cell,
-            };
+            let options = options(shape_cell, true);
             for level in [0, 2] {
                 let dists = grid.distributions(level, options).unwrap();
                 let inv = 1.0 / (0.02 * f64::from(1u32 << level));
@@ -236,13 +242,7 @@ mod tests {
         let centre = Vector2::new(0.625, 0.625);
         let key = CellKey { ix: 2, iy: 2 };
         for shape_cell in [0.0, 1.0] {
-            let options = DistOptions {
-                expansion: 10.0,
-                fuse_minority: false,
-                sigma_floor: 0.005,
-                shape_cell,
-            };
-            let dists = grid.distributions(0, options).unwrap();
+            let dists = grid.distributions(0, options(shape_cell, false)).unwrap();
             let (got, n) = dists.visit(Search {
                 point: centre,
                 key,

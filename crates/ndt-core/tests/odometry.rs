@@ -195,6 +195,24 @@ fn mapper_behind_the_loop_equals_the_mapper_in_line() {
     assert_eq!(inline.2, behind.2);
 }
 
+/// Scans of the walk through the square in the map tests below.
+const WALK_SCANS: u32 = 24;
+/// The scan after which a scan is handed to the map alone (`update_map`).
+const HANDED_OVER: u32 = 17;
+
+/// Pose `i` of that walk: 2 cm, 1 cm and 0.01 rad a scan.
+fn walk(i: u32) -> Pose2 {
+    let t = f64::from(i);
+    Pose2::new(0.02 * t, 0.01 * t, 0.01 * t)
+}
+
+/// The scan handed to the map alone, with its pose: 97 beams, angles the
+/// loop has not seen.
+fn handed_over() -> (Pose2, (Vec<f64>, Vec<f64>)) {
+    let at = Pose2::new(0.3, 0.1, 0.1);
+    (at, square_scan(at, 97))
+}
+
 /// The loop hands its mapper the beams' kept sines and cosines (one per beam
 /// for the whole run) instead of a sine and cosine per beam and scan: the
 /// mapper must be the same, bit for bit, as one fed the same scans at the
@@ -214,18 +232,15 @@ fn the_loops_mapper_equals_a_mapper_fed_the_same_scans() {
         ..config.mapper
     };
     let mut mapper = Mapper::new(config.cell_size, options).unwrap();
-    for i in 0..24 {
-        let t = f64::from(i);
-        let truth = Pose2::new(0.02 * t, 0.01 * t, 0.01 * t);
+    for i in 0..WALK_SCANS {
         let beams = if i < 12 { 361 } else { 181 };
-        let (r, a) = square_scan(truth, beams);
+        let (r, a) = square_scan(walk(i), beams);
         let step = odo.step(&r, &a, None).unwrap();
         if step.inserted {
             mapper.insert_scan(&r, &a, step.pose).unwrap();
         }
-        if i == 17 {
-            let at = Pose2::new(0.3, 0.1, 0.1);
-            let (r, a) = square_scan(at, 97);
+        if i == HANDED_OVER {
+            let (at, (r, a)) = handed_over();
             odo.update_map(&r, &a, at).unwrap();
             mapper.insert_scan(&r, &a, at).unwrap();
         }
@@ -402,18 +417,16 @@ fn a_loop_without_a_map_gives_the_same_poses_and_grid() {
         ..with_map
     })
     .unwrap();
-    for i in 0..24 {
-        let t = f64::from(i);
-        let (r, a) = square_scan(Pose2::new(0.02 * t, 0.01 * t, 0.01 * t), 181);
+    for i in 0..WALK_SCANS {
+        let (r, a) = square_scan(walk(i), 181);
         let (s_full, s_bare) = (
             full.step(&r, &a, None).unwrap(),
             bare.step(&r, &a, None).unwrap(),
         );
         assert_eq!(s_full.pose, s_bare.pose, "scan {i}");
         assert!(!s_bare.inserted);
-        if i == 17 {
-            let at = Pose2::new(0.3, 0.1, 0.1);
-            let (r, a) = square_scan(at, 97);
+        if i == HANDED_OVER {
+            let (at, (r, a)) = handed_over();
             full.update_map(&r, &a, at).unwrap();
             bare.update_map(&r, &a, at).unwrap();
         }
