@@ -1,10 +1,11 @@
 //! Profiling harness: a log's scans from a dump of `benches/dump_scans.py`.
 //!
-//! `replay <dump> odometry [reps] [inline|loop-only|poses-only]`: `Odometry`
+//! `replay <dump> odometry [reps] [inline|loop-only|poses-only|no-filter]`: `Odometry`
 //! (default configuration; `inline`: `background_mapper: false`;
 //! `loop-only`: the mapper takes the first scan only, so the loop runs
 //! without a mapper's work beside it, with the same poses; `poses-only`:
-//! `build_map: false`, no mapper at all, hash 0) over every scan, `reps` times;
+//! `build_map: false`, no mapper at all, hash 0; `no-filter`: the mapper
+//! without the §V elimination, so its thread only inserts) over every scan, `reps` times;
 //! prints the time per scan, the last pose and a hash of the mapper (every
 //! pyramid level's sums and the §V filter's records), so two builds can be
 //! compared for bit-identical maps.
@@ -95,6 +96,9 @@ fn odometry(scans: &[Scan], reps: usize, variant: Option<&str>) -> Result<(), Bo
         config.insert_angle = 1e9;
     }
     config.build_map = variant != Some("poses-only");
+    if variant == Some("no-filter") {
+        config.mapper.outlier_filter = false;
+    }
     for _ in 0..reps {
         let mut odo = Odometry::new(config)?;
         let t = Instant::now();
@@ -306,7 +310,7 @@ fn threads(scans: &[Scan], reps: usize) -> Result<(), Box<dyn Error>> {
 fn main() -> Result<(), Box<dyn Error>> {
     let args: Vec<String> = std::env::args().collect();
     let usage =
-        "usage: replay <dump> odometry [reps] [inline|loop-only|poses-only] | matchhash | mapwork [reps] | threads [reps]";
+        "usage: replay <dump> odometry [reps] [inline|loop-only|poses-only|no-filter] | matchhash | mapwork [reps] | threads [reps]";
     let (Some(path), Some(mode)) = (args.get(1), args.get(2)) else {
         return Err(usage.into());
     };
@@ -317,7 +321,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             args.get(3).map_or(Ok(1), |s| s.parse())?,
             match args.get(4).map(String::as_str) {
                 None => None,
-                Some(v @ ("inline" | "loop-only" | "poses-only")) => Some(v),
+                Some(v @ ("inline" | "loop-only" | "poses-only" | "no-filter")) => Some(v),
                 Some(_) => return Err(usage.into()),
             },
         ),
