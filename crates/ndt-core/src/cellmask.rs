@@ -176,6 +176,14 @@ impl CellMaskReader<'_> {
         self.word(split(key).0) & quarter_mask(half_x, half_y) != 0
     }
 
+    /// The word of the block holding `key` (0 when the set has none of its
+    /// cells) and `key`'s bit in it.
+    #[inline]
+    pub fn word_and_bit(&mut self, key: CellKey) -> (u64, u32) {
+        let (block, bit) = split(key);
+        (self.word(block), bit)
+    }
+
     /// `true` when `key` is in the set.
     #[inline]
     pub fn contains(&mut self, key: CellKey) -> bool {

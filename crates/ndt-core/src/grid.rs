@@ -17,8 +17,10 @@ use crate::table::CellTable;
 
 mod deferral;
 mod edit;
+mod removals;
 
 pub use edit::MAX_CELL_COUNT;
+pub use removals::RemovalStamp;
 
 /// How many prepared distribution sets (one per pyramid level and distinct
 /// expansion/fusion setting) a grid keeps between calls.
@@ -85,6 +87,9 @@ pub struct NdtGrid {
     pending: Vec<CellKey>,
     /// Open deferrals (they nest).
     deferring: u32,
+    /// Who this grid is and how many fine cells it has lost
+    /// ([`NdtGrid::removal_stamp`]).
+    removals: removals::Removals,
 }
 
 impl Clone for NdtGrid {
@@ -105,6 +110,8 @@ impl Clone for NdtGrid {
             ),
             pending: self.pending.clone(),
             deferring: 1,
+            // Another grid: its removals are its own from here on.
+            removals: removals::Removals::new(),
         };
         copy.end_deferral();
         copy
@@ -142,6 +149,7 @@ impl NdtGrid {
             prepared: Mutex::new(Vec::new()),
             pending: Vec::new(),
             deferring: 0,
+            removals: removals::Removals::new(),
         })
     }
 
@@ -292,6 +300,7 @@ impl NdtGrid {
         if self.deferring > 0 {
             let removed = self.pyramid.remove_fine(keys);
             self.pending.extend_from_slice(&removed);
+            self.removals.add(removed.len());
             return removed.len();
         }
         let touched = self.pyramid.remove(keys);
@@ -299,6 +308,7 @@ impl NdtGrid {
         if removed == 0 {
             return 0;
         }
+        self.removals.add(removed);
         self.update_prepared(&touched);
         removed
     }

@@ -2,11 +2,14 @@
 //! a bit per cell ([`CellMask`]), and, once a probe has asked, a bit per
 //! block of 4 × 4 cells that holds any. The second answers, for the §V beam
 //! walks ([`crate::filter::raywalk::walk_cells_in_skipping`]), "may a cell
-//! of this block hold points?" on blocks of 16 × 16 cells (a quarter of one
-//! of its words) and of 4 × 4 (one of its bits) with one look-up per 32 × 32
-//! cells, and without the pyramid's coarser levels, so it holds while those
-//! wait to be brought up to date (a deferral, `NdtGrid::deferral`). A grid that
-//! is never walked (the odometry loop's matching grid) never builds it.
+//! of this block hold points?" on blocks of 32 × 32 cells (one of its
+//! words), 16 × 16 (a quarter of one), 8 × 8 (2 × 2 of its bits) and 4 × 4
+//! (one bit), all four from one look-up ([`OccupancyProbe::empty_block`]),
+//! and without the pyramid's coarser levels, so it holds while those wait to
+//! be brought up to date (a deferral, `NdtGrid::deferral`). A grid that is
+//! never walked (the odometry loop's matching grid) never builds it. With
+//! the 32 × 32 and 8 × 8 blocks added to the other two, the odometry
+//! helper's instructions fell by 7 % (BENCHMARK.md, "Speed", session 24).
 
 use std::sync::OnceLock;
 
@@ -16,6 +19,19 @@ use crate::key::CellKey;
 /// log2 of the side \[cells\] of the blocks with a bit each: a quarter of
 /// a word of the cells' mask (so a block empties when that quarter does).
 const SMALL_BITS: i32 = WORD_BITS - 1;
+
+/// The quarters of a word of the blocks' mask, by `qx + 2 qy`
+/// ([`quarter_mask`]).
+const QUARTERS: [u64; 4] = [
+    quarter_mask(0, 0),
+    quarter_mask(1, 0),
+    quarter_mask(0, 1),
+    quarter_mask(1, 1),
+];
+
+/// 2 × 2 bits at the origin of a word of the blocks' mask (its rows are
+/// `2^WORD_BITS` bits apart).
+const PAIR_ROWS: u64 = 0b11 | 0b11 << (1 << WORD_BITS);
 
 /// The block of 4 × 4 cells holding `key`, as a key of that lattice.
 #[inline]
@@ -145,6 +161,38 @@ impl OccupancyProbe<'_> {
     pub fn may_hold_inner(&mut self, key: CellKey) -> bool {
         self.blocks.contains(small_block(key))
     }
+
+    /// log2 of the side \[fine cells\] of the largest aligned block of 32 ×
+    /// 32, 16 × 16, 8 × 8 or 4 × 4 fine cells holding `key` that holds no
+    /// points and not `last` (5, 4, 3 or 2); `None` when even the 4 × 4
+    /// block holds points or `last`. The four are one word of the blocks'
+    /// mask, a quarter of it, 2 × 2 of its bits and one bit: one look-up
+    /// answers them all (the §V walks ask this at every step,
+    /// [`crate::filter::raywalk::walk_cells_in_skipping`]).
+    #[inline]
+    pub fn empty_block(&mut self, key: CellKey, last: CellKey) -> Option<u32> {
+        let small = small_block(key);
+        let (word, bit) = self.blocks.word_and_bit(small);
+        // The 4 × 4 block's column and row within the word's 8 × 8.
+        let side = (1 << WORD_BITS) - 1;
+        let (x, y) = (small.ix & side, small.iy & side);
+        let half = WORD_BITS - 1;
+        let apart = |b: i32| (key.ix >> b, key.iy >> b) != (last.ix >> b, last.iy >> b);
+        let quarter = QUARTERS[((x >> half) | ((y >> half) << 1)) as usize];
+        let pair = PAIR_ROWS << ((x & !1) | ((y & !1) << WORD_BITS));
+        let b = if word == 0 && apart(SMALL_BITS + WORD_BITS) {
+            SMALL_BITS + WORD_BITS
+        } else if word & quarter == 0 && apart(SMALL_BITS + half) {
+            SMALL_BITS + half
+        } else if word & pair == 0 && apart(SMALL_BITS + 1) {
+            SMALL_BITS + 1
+        } else if word >> bit & 1 == 0 && apart(SMALL_BITS) {
+            SMALL_BITS
+        } else {
+            return None;
+        };
+        Some(b as u32)
+    }
 }
 
 #[cfg(test)]
@@ -196,6 +244,16 @@ mod tests {
                 };
                 assert_eq!(probe.may_hold(key), near(4), "{key:?}");
                 assert_eq!(probe.may_hold_inner(key), near(2), "{key:?}");
+                // The largest empty block without `last`, of 32 down to 4
+                // cells a side, from one word.
+                for last in [key, CellKey { ix: 3, iy: -5 }, CellKey { ix: -17, iy: 30 }] {
+                    let apart = |b: i32| (ix >> b, iy >> b) != (last.ix >> b, last.iy >> b);
+                    let want = [5, 4, 3, 2]
+                        .into_iter()
+                        .find(|&b| !near(b) && apart(b))
+                        .map(|b| b as u32);
+                    assert_eq!(probe.empty_block(key, last), want, "{key:?} {last:?}");
+                }
             }
         }
     }

@@ -39,6 +39,23 @@ pub trait EmptyBlocks {
     fn inner_is_empty(&mut self, _key: CellKey) -> bool {
         false
     }
+    /// log2 of the side \[cells\] of the largest block holding `key` that
+    /// is empty and does not hold `last` (the segment's end cell, always
+    /// walked); `None`: no such block. By default the block of
+    /// [`EmptyBlocks::block_bits`], else the smaller one of
+    /// [`EmptyBlocks::inner_bits`]; a source that answers several sizes from
+    /// one look-up overrides it.
+    #[inline]
+    fn empty_block(&mut self, key: CellKey, last: CellKey) -> Option<u32> {
+        let apart = |b: u32| (key.ix >> b, key.iy >> b) != (last.ix >> b, last.iy >> b);
+        if let Some(b) = self.block_bits().filter(|&b| b < 31) {
+            if apart(b) && self.is_empty(key) {
+                return Some(b);
+            }
+        }
+        self.inner_bits()
+            .filter(|&b| b < 31 && apart(b) && self.inner_is_empty(key))
+    }
 }
 
 /// The blocks a grid's occupancy shows empty ([`crate::occupancy::OccupancyProbe`]).
@@ -54,6 +71,12 @@ impl EmptyBlocks for crate::occupancy::OccupancyProbe<'_> {
     }
     fn inner_is_empty(&mut self, key: CellKey) -> bool {
         !self.may_hold_inner(key)
+    }
+    /// Four sizes, 32 × 32 down to 4 × 4 cells, from one word
+    /// ([`crate::occupancy::OccupancyProbe::empty_block`]).
+    #[inline]
+    fn empty_block(&mut self, key: CellKey, last: CellKey) -> Option<u32> {
+        crate::occupancy::OccupancyProbe::empty_block(self, key, last)
     }
 }
 
@@ -100,9 +123,10 @@ pub fn walk_cells_in(
 /// the same distances. The block holding the end point is walked cell by
 /// cell. A beam through free space then costs a few operations per block
 /// (and one per crossing of the axis it does not leave by) instead of a
-/// visit per cell (the §V walks, [`crate::filter::confirmation`]); inside a
-/// block that is not empty, the smaller empty blocks of
-/// [`EmptyBlocks::inner_bits`] are crossed the same way.
+/// visit per cell (the §V walks, [`crate::filter::confirmation`]); at every
+/// step the largest empty block [`EmptyBlocks::empty_block`] reports is
+/// crossed, so inside a block that is not empty the smaller empty ones are
+/// crossed the same way.
 pub fn walk_cells_in_skipping(
     from: Vector2<f64>,
     to: Vector2<f64>,
@@ -211,24 +235,14 @@ fn walk_until(
     let budget = (i64::from(last.ix) - i64::from(key.ix)).unsigned_abs()
         + (i64::from(last.iy) - i64::from(key.iy)).unsigned_abs()
         + 2;
-    let bits = skip.block_bits().filter(|&b| b < 31);
-    let inner_bits = skip.inner_bits().filter(|&b| b < 31);
-    let block_of = |k: CellKey, b: u32| (k.ix >> b, k.iy >> b);
     let mut t_in = 0.0;
     let mut walked: u64 = 0;
     while walked < budget {
         if t_in > stop {
             return;
         }
-        // The block of `key`, or else its smaller block, when empty (and not
-        // the end point's).
-        let empty = match (bits, inner_bits) {
-            (Some(b), _) if block_of(key, b) != block_of(last, b) && skip.is_empty(key) => Some(b),
-            (_, Some(b)) if block_of(key, b) != block_of(last, b) && skip.inner_is_empty(key) => {
-                Some(b)
-            }
-            _ => None,
-        };
+        // The largest empty block of `key` (not the end point's).
+        let empty = skip.empty_block(key, last).filter(|&b| b < 31);
         if let Some(b) = empty {
             // Cross the block as the loop below would, without visits:
             // the `n`-th crossing along an axis leaves the block, and the
@@ -438,6 +452,70 @@ mod tests {
             },
         );
         assert_eq!(n, 0);
+    }
+
+    /// With a grid's own probe (blocks of 32, 16, 8 and 4 cells a side, one
+    /// word each, [`crate::occupancy::OccupancyProbe::empty_block`]) the walk
+    /// meets every occupied cell the cell-by-cell walk meets, in the same
+    /// order and with the same distances to the bit: on a map of walls and
+    /// specks with holes cut out, from inside and outside it, ending in
+    /// empty space and on occupied cells.
+    #[test]
+    fn a_grids_probe_skips_only_empty_space() {
+        let mut rng = StdRng::seed_from_u64(17);
+        let cell = 0.02;
+        let mut grid = crate::NdtGrid::new(cell).unwrap();
+        let mut pts: Vec<[f64; 2]> = Vec::new();
+        for _ in 0..12 {
+            // A wall of 0.5–3 m in any direction.
+            let (x, y) = (rng.random_range(-4.0..4.0), rng.random_range(-4.0..4.0));
+            let a: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+            let len = rng.random_range(0.5..3.0);
+            for i in 0..(len / 0.01) as usize {
+                let t = i as f64 * 0.01;
+                pts.push([x + t * a.cos(), y + t * a.sin()]);
+            }
+        }
+        for _ in 0..300 {
+            pts.push([rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0)]);
+        }
+        grid.insert(&pts, crate::Pose2::identity()).unwrap();
+        let mut keys: Vec<CellKey> = grid.keys().collect();
+        keys.sort_unstable();
+        let holes: Vec<CellKey> = keys.iter().copied().step_by(7).collect();
+        grid.remove_cells(&holes);
+        let occupied = |k: CellKey| grid.stats(k).is_some();
+        let mut met_any = 0;
+        for case in 0..3000 {
+            let a = Vector2::new(rng.random_range(-6.0..6.0), rng.random_range(-6.0..6.0));
+            // Every third segment ends on a point of the map.
+            let b = if case % 3 == 0 {
+                let p = pts[rng.random_range(0..pts.len())];
+                Vector2::new(p[0], p[1])
+            } else {
+                Vector2::new(rng.random_range(-6.0..6.0), rng.random_range(-6.0..6.0))
+            };
+            let run = |skipping: bool| {
+                let mut out = Vec::new();
+                let visit = |k: CellKey, t0: f64, t1: f64| {
+                    if occupied(k) {
+                        out.push((k, t0.to_bits(), t1.to_bits()));
+                    }
+                    true
+                };
+                if skipping {
+                    let mut probe = grid.occupancy_probe();
+                    walk_cells_in_skipping(a, b, cell, grid.key_bounds(), &mut probe, visit);
+                } else {
+                    walk_cells_in(a, b, cell, grid.key_bounds(), visit);
+                }
+                out
+            };
+            let want = run(false);
+            assert_eq!(run(true), want, "case {case}: {a:?} -> {b:?}");
+            met_any += usize::from(!want.is_empty());
+        }
+        assert!(met_any > 1000, "{met_any} walks met an occupied cell");
     }
 
     /// Blocks of 8 × 8 cells, and smaller ones of 2 × 2 cells when the

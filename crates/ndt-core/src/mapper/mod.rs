@@ -9,6 +9,7 @@ mod counts;
 mod options;
 mod pipeline;
 mod restore;
+mod stale;
 
 pub(crate) use pipeline::CheckedScan;
 
@@ -20,9 +21,10 @@ use crate::error::Result;
 use crate::filter::areas::unconfirmed_small;
 use crate::filter::objects::{group_objects, SmallObject};
 use crate::filter::observation::{rarely_seen, CellInfo, CellTable};
-use crate::grid::NdtGrid;
+use crate::grid::{NdtGrid, RemovalStamp};
 use crate::key::CellKey;
 use crate::se2::Pose2;
+use stale::StaleRecords;
 
 /// The state of the §V elimination for one map: per-cell observation
 /// records, the scan counter and the removal counters.
@@ -32,6 +34,8 @@ pub struct MapFilter {
     table: CellTable,
     scans: u64,
     counts: RemovalCounts,
+    /// The records that may have lost their cell since the last check.
+    stale: StaleRecords,
 }
 
 impl MapFilter {
@@ -43,6 +47,7 @@ impl MapFilter {
             table: CellTable::default(),
             scans: 0,
             counts: RemovalCounts::default(),
+            stale: StaleRecords::default(),
         })
     }
 
@@ -99,9 +104,9 @@ impl MapFilter {
         let mut deferred = grid.deferral();
         let grid: &mut NdtGrid = &mut deferred;
         // Forget cells that left the grid by other means (asked of the
-        // grid's occupancy mask, not its sums: the whole table every check).
-        let mut occupied = grid.occupancy();
-        self.table.retain(|k, _| occupied.contains(*k));
+        // grid's occupancy mask, not its sums: the keys the mapper removed,
+        // or the whole table when something else removed cells).
+        self.stale.forget(&mut self.table, grid);
         let mut removed = 0;
         if self.options.on(self.options.area1_confirmation) {
             let keys = unconfirmed_small(&self.table);
@@ -130,7 +135,16 @@ impl MapFilter {
         for k in keys {
             self.table.remove(k);
         }
-        grid.remove_cells(keys)
+        let before = grid.removal_stamp();
+        let n = grid.remove_cells(keys);
+        self.stale.removed(before, keys, n, false, self.table.len());
+        n
+    }
+
+    /// The mapper removed `keys` from `grid` (`n` cells, its stamp
+    /// `before`); their records go with the next periodic check.
+    fn mapper_removed(&mut self, before: RemovalStamp, keys: &[CellKey], n: usize) {
+        self.stale.removed(before, keys, n, true, self.table.len());
     }
 }
 
@@ -225,7 +239,10 @@ impl Mapper {
     /// Removes the cells `keys` from the map (see [`NdtGrid::remove_cells`]);
     /// their filter records go with the next periodic check.
     pub fn remove_cells(&mut self, keys: &[CellKey]) -> usize {
-        self.grid.remove_cells(keys)
+        let before = self.grid.removal_stamp();
+        let n = self.grid.remove_cells(keys);
+        self.filter.mapper_removed(before, keys, n);
+        n
     }
 
     /// Runs the periodic checks now (see [`MapFilter::run_checks`]).

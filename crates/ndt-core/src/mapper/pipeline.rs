@@ -70,6 +70,8 @@ impl MapFilter {
         // the coarser levels up to date once (NdtGrid::deferral, crate/src/grid/deferral.rs).
         let mut deferred = grid.deferral();
         let grid: &mut NdtGrid = &mut deferred;
+        // The records below are of this grid's cells.
+        self.stale.follow(grid);
         // A scan with no valid beam (a blinded sensor, a driver sending only
         // NaN, 0 or inf) observes nothing: it changes neither the map nor the
         // filter, not even the scan counter, so a burst of them cannot age

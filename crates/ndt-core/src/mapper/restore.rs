@@ -78,6 +78,7 @@ impl MapFilter {
             table,
             scans,
             counts,
+            stale: super::StaleRecords::default(),
         })
     }
 }
