@@ -400,8 +400,8 @@ impl NdtGrid {
 
 impl NdtGrid {
     /// An [`OccupancyProbe`] of this grid: "may a cell of this block hold
-    /// points?" on blocks of 16 × 16 and 4 × 4 fine cells, from the
-    /// occupancy masks (see [`crate::occupancy`]). It read the pyramid's
+    /// points?" on blocks of 32 × 32, 16 × 16, 8 × 8 and 4 × 4 fine cells,
+    /// from the occupancy masks (see [`crate::occupancy`]). It read the pyramid's
     /// 32 cm and 8 cm levels before (the same blocks on a 2 cm grid, the
     /// same answers): `replay intel3k odometry 1 inline`, callgrind, in
     /// BENCHMARK.md, "Speed", session 19.

@@ -3,7 +3,7 @@
 //! The §V filter keeps a record per map cell and must forget the records of
 //! cells that left the grid by other means than its own deletions (the
 //! odometry loop's map window, a caller's [`NdtGrid::remove_cells`]). Asking
-//! the grid about every record at every periodic check was 13–14 % of the
+//! the grid about every record at every periodic check was about 14 % of the
 //! odometry helper's instructions (BENCHMARK.md, "Speed", session 24). With
 //! this count the filter tells "the grid lost only the cells I know of" from
 //! "something else removed cells": equal stamps of one grid mean no cell left

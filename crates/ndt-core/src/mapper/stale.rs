@@ -5,7 +5,7 @@
 //! by other means: [`crate::Mapper::remove_cells`] (the odometry loop's map
 //! window, every inserted scan) and anyone holding the grid (the Python
 //! binding shares it). Each periodic check forgets the records whose cells
-//! are gone. Asking the grid about every record there cost 13–14 % of the
+//! are gone. Asking the grid about every record there cost about 14 % of the
 //! odometry helper's instructions (BENCHMARK.md, "Speed", session 24); this
 //! remembers the keys the mapper removed and the grid's removal count
 //! ([`NdtGrid::removal_stamp`]), so that a check asks about those keys only
