@@ -3,8 +3,9 @@
 //! A record lives as long as its cell holds points. The filter deletes
 //! cells with their records (steps b-1, c, d), but cells also leave the grid
 //! by other means: [`crate::Mapper::remove_cells`] (the odometry loop's map
-//! window, every inserted scan) and anyone holding the grid (the Python
-//! binding shares it). Each periodic check forgets the records whose cells
+//! window, every inserted scan) and whoever else holds the grid
+//! ([`crate::mapper::MapFilter`] works on a grid its caller keeps, e.g. the
+//! Python binding's shared one). Each periodic check forgets the records whose cells
 //! are gone. Asking the grid about every record there cost about 14 % of the
 //! odometry helper's instructions (BENCHMARK.md, "Speed", session 24); this
 //! remembers the keys the mapper removed and the grid's removal count
