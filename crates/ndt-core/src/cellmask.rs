@@ -33,6 +33,30 @@ pub const fn quarter_mask(qx: i32, qy: i32) -> u64 {
     m << (((qy * HALF) << BLOCK_BITS) | (qx * HALF))
 }
 
+/// The quarters' bits by `qx + 2 qy` ([`quarter_mask`]).
+const QUARTERS: [u64; 4] = [
+    quarter_mask(0, 0),
+    quarter_mask(1, 0),
+    quarter_mask(0, 1),
+    quarter_mask(1, 1),
+];
+
+/// The bits of the word of `key`'s block for the quarter holding `key`.
+#[inline]
+pub fn quarter_bits(key: CellKey) -> u64 {
+    let half_x = (key.ix & MASK) >> (BLOCK_BITS - 1);
+    let half_y = (key.iy & MASK) >> (BLOCK_BITS - 1);
+    QUARTERS[(half_x | (half_y << 1)) as usize]
+}
+
+/// The bits of the word of `key`'s block for the aligned 2 × 2 cells
+/// holding `key` (two bits in each of two rows, `2^BLOCK_BITS` bits apart).
+#[inline]
+pub fn pair_bits(key: CellKey) -> u64 {
+    const ROWS: u64 = 0b11 | 0b11 << (1 << BLOCK_BITS);
+    ROWS << ((key.ix & MASK & !1) | ((key.iy & MASK & !1) << BLOCK_BITS))
+}
+
 /// One bit per cell of a set of cells.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct CellMask {
@@ -171,9 +195,7 @@ impl CellMaskReader<'_> {
     /// `key`: the quarter's rows of the block's word.
     #[inline]
     pub fn any_in_quarter(&mut self, key: CellKey) -> bool {
-        let half_x = (key.ix & MASK) >> (BLOCK_BITS - 1);
-        let half_y = (key.iy & MASK) >> (BLOCK_BITS - 1);
-        self.word(split(key).0) & quarter_mask(half_x, half_y) != 0
+        self.word(split(key).0) & quarter_bits(key) != 0
     }
 
     /// The word of the block holding `key` (0 when the set has none of its
@@ -187,8 +209,8 @@ impl CellMaskReader<'_> {
     /// `true` when `key` is in the set.
     #[inline]
     pub fn contains(&mut self, key: CellKey) -> bool {
-        let (block, bit) = split(key);
-        self.word(block) >> bit & 1 == 1
+        let (word, bit) = self.word_and_bit(key);
+        word >> bit & 1 == 1
     }
 
     /// The members of the 3 × 3 block of cells around `key` as 9 bits, bit

@@ -56,6 +56,10 @@ pub mod solver;
 pub mod table;
 #[cfg(test)]
 mod testing;
+// The integration tests' fixtures (`tests/common`) name the crate `ndt_core`;
+// unit tests that share them need the name too.
+#[cfg(test)]
+extern crate self as ndt_core;
 pub mod window;
 
 pub use cell::{CellStats, Gaussian};

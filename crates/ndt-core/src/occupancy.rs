@@ -13,25 +13,15 @@
 
 use std::sync::OnceLock;
 
-use crate::cellmask::{quarter_mask, CellMask, CellMaskReader, BLOCK_BITS as WORD_BITS};
+use crate::cellmask::{
+    pair_bits, quarter_bits, quarter_mask, CellMask, CellMaskReader, BLOCK_BITS as WORD_BITS,
+};
 use crate::key::CellKey;
+use crate::pyramid::coarse_key;
 
 /// log2 of the side \[cells\] of the blocks with a bit each: a quarter of
 /// a word of the cells' mask (so a block empties when that quarter does).
 const SMALL_BITS: i32 = WORD_BITS - 1;
-
-/// The quarters of a word of the blocks' mask, by `qx + 2 qy`
-/// ([`quarter_mask`]).
-const QUARTERS: [u64; 4] = [
-    quarter_mask(0, 0),
-    quarter_mask(1, 0),
-    quarter_mask(0, 1),
-    quarter_mask(1, 1),
-];
-
-/// 2 × 2 bits at the origin of a word of the blocks' mask (its rows are
-/// `2^WORD_BITS` bits apart).
-const PAIR_ROWS: u64 = 0b11 | 0b11 << (1 << WORD_BITS);
 
 /// The block of 4 × 4 cells holding `key`, as a key of that lattice.
 #[inline]
@@ -173,18 +163,13 @@ impl OccupancyProbe<'_> {
     pub fn empty_block(&mut self, key: CellKey, last: CellKey) -> Option<u32> {
         let small = small_block(key);
         let (word, bit) = self.blocks.word_and_bit(small);
-        // The 4 × 4 block's column and row within the word's 8 × 8.
-        let side = (1 << WORD_BITS) - 1;
-        let (x, y) = (small.ix & side, small.iy & side);
-        let half = WORD_BITS - 1;
-        let apart = |b: i32| (key.ix >> b, key.iy >> b) != (last.ix >> b, last.iy >> b);
-        let quarter = QUARTERS[((x >> half) | ((y >> half) << 1)) as usize];
-        let pair = PAIR_ROWS << ((x & !1) | ((y & !1) << WORD_BITS));
+        let apart = |b: i32| coarse_key(key, b as usize) != coarse_key(last, b as usize);
+        // Largest first; each part's bits only when the larger one holds points.
         let b = if word == 0 && apart(SMALL_BITS + WORD_BITS) {
             SMALL_BITS + WORD_BITS
-        } else if word & quarter == 0 && apart(SMALL_BITS + half) {
-            SMALL_BITS + half
-        } else if word & pair == 0 && apart(SMALL_BITS + 1) {
+        } else if word & quarter_bits(small) == 0 && apart(SMALL_BITS + WORD_BITS - 1) {
+            SMALL_BITS + WORD_BITS - 1
+        } else if word & pair_bits(small) == 0 && apart(SMALL_BITS + 1) {
             SMALL_BITS + 1
         } else if word >> bit & 1 == 0 && apart(SMALL_BITS) {
             SMALL_BITS

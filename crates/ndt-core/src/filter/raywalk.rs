@@ -47,7 +47,10 @@ pub trait EmptyBlocks {
     /// one look-up overrides it.
     #[inline]
     fn empty_block(&mut self, key: CellKey, last: CellKey) -> Option<u32> {
-        let apart = |b: u32| (key.ix >> b, key.iy >> b) != (last.ix >> b, last.iy >> b);
+        let apart = |b: u32| {
+            crate::pyramid::coarse_key(key, b as usize)
+                != crate::pyramid::coarse_key(last, b as usize)
+        };
         if let Some(b) = self.block_bits().filter(|&b| b < 31) {
             if apart(b) && self.is_empty(key) {
                 return Some(b);

@@ -137,14 +137,14 @@ impl MapFilter {
         }
         let before = grid.removal_stamp();
         let n = grid.remove_cells(keys);
-        self.stale.removed(before, keys, n, false, self.table.len());
+        self.stale.deleted(before, n);
         n
     }
 
     /// The mapper removed `keys` from `grid` (`n` cells, its stamp
     /// `before`); their records go with the next periodic check.
     fn mapper_removed(&mut self, before: RemovalStamp, keys: &[CellKey], n: usize) {
-        self.stale.removed(before, keys, n, true, self.table.len());
+        self.stale.removed(before, keys, n, self.table.len());
     }
 }
 

@@ -44,31 +44,42 @@ impl StaleRecords {
         }
     }
 
-    /// `n` cells of `keys` left the grid, whose stamp was `before`: by the
-    /// filter's deletions, records and all (`kept` false), or by the
-    /// mapper's, records kept until the next check (`kept` true). More kept
-    /// keys than `limit` (the records' number: a pass over all of them costs
-    /// no more) leave nothing known.
+    /// The filter deleted `n` cells, records and all, from the grid whose
+    /// stamp was `before`.
+    pub(crate) fn deleted(&mut self, before: RemovalStamp, n: usize) {
+        self.advance(before, n);
+    }
+
+    /// The mapper removed `n` cells of `keys` from the grid whose stamp was
+    /// `before`; their records are kept until the next check. More kept keys
+    /// than `limit` (the records' number: a pass over all of them costs no
+    /// more) leave nothing known.
     pub(crate) fn removed(
         &mut self,
         before: RemovalStamp,
         keys: &[CellKey],
         n: usize,
-        kept: bool,
         limit: usize,
     ) {
-        if self.expected != Some(before) {
-            self.unknown();
+        if !self.advance(before, n) || n == 0 {
             return;
         }
-        self.expected = Some(before.advanced(n));
-        if kept && n > 0 {
-            if self.removed.len() + keys.len() > limit {
-                self.unknown();
-            } else {
-                self.removed.extend_from_slice(keys);
-            }
+        if self.removed.len() + keys.len() > limit {
+            self.unknown();
+        } else {
+            self.removed.extend_from_slice(keys);
         }
+    }
+
+    /// `n` cells left the grid whose stamp was `before`: `false`, and
+    /// nothing known, when that is not the stamp expected.
+    fn advance(&mut self, before: RemovalStamp, n: usize) -> bool {
+        if self.expected != Some(before) {
+            self.unknown();
+            return false;
+        }
+        self.expected = Some(before.advanced(n));
+        true
     }
 
     /// Forgets the records of `table` whose cells `grid` no longer holds
@@ -84,8 +95,8 @@ impl StaleRecords {
             }
         } else {
             table.retain(|k, _| occupied.contains(*k));
+            self.removed.clear();
         }
-        self.removed.clear();
         self.expected = Some(now);
     }
 
@@ -96,53 +107,35 @@ impl StaleRecords {
     }
 }
 
+/// The integration tests' ray caster, shared.
+#[cfg(test)]
+#[path = "../../tests/common/mod.rs"]
+mod fixtures;
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
 
+    use super::fixtures::{room, scan as cast_scan};
     use super::StaleRecords;
     use crate::key::CellKey;
     use crate::mapper::{Mapper, MapperOptions};
     use crate::se2::Pose2;
 
-    /// Ranges of 181 beams over 180° from `pose` in a 4 × 4 m room, with a
-    /// 30 cm box in it until scan 40 (so that step d clears it) and 5 mm
-    /// noise.
+    /// Ranges and angles of 181 beams over 180° from `pose` in the fixtures'
+    /// room, with a 30 cm box in it until scan 40 (so that step d clears it)
+    /// and 5 mm noise.
     fn scan(pose: Pose2, k: usize, rng: &mut StdRng) -> (Vec<f64>, Vec<f64>) {
-        let mut walls = vec![
-            ([-2.0, -2.0], [2.0, -2.0]),
-            ([2.0, -2.0], [2.0, 2.0]),
-            ([2.0, 2.0], [-2.0, 2.0]),
-            ([-2.0, 2.0], [-2.0, -2.0]),
-        ];
+        let mut walls = room();
         if k < 40 {
             walls.extend([([0.5, 0.5], [0.8, 0.5]), ([0.8, 0.5], [0.8, 0.8])]);
         }
-        let angles: Vec<f64> = (0..181)
-            .map(|i| (f64::from(i) - 90.0).to_radians())
-            .collect();
-        let ranges = angles
-            .iter()
-            .map(|a| {
-                let (s, c) = (pose.theta + a).sin_cos();
-                let hit = walls.iter().filter_map(|(p, q)| {
-                    // The ray (pose + t (c, s)) against the segment p + u (q − p).
-                    let (ex, ey) = (q[0] - p[0], q[1] - p[1]);
-                    let det = ex * s - ey * c;
-                    if det.abs() < 1e-12 {
-                        return None;
-                    }
-                    let (wx, wy) = (p[0] - pose.x, p[1] - pose.y);
-                    let t = (ex * wy - ey * wx) / det;
-                    let u = (c * wy - s * wx) / det;
-                    (t > 0.0 && (0.0..=1.0).contains(&u)).then_some(t)
-                });
-                hit.fold(f64::INFINITY, f64::min) + rng.random_range(-0.005..0.005)
-            })
-            .collect();
-        (ranges, angles)
+        let pts = cast_scan(&walls, pose, 181, std::f64::consts::PI, 0.005, rng.random());
+        pts.iter()
+            .map(|p| (p[0].hypot(p[1]), p[1].atan2(p[0])))
+            .unzip()
     }
 
     /// A mapper that asks the grid about the keys it removed keeps the same
