@@ -10,6 +10,7 @@
 
 use rustc_hash::FxHashMap;
 
+use crate::directmemo::DirectMemo;
 use crate::key::CellKey;
 use crate::parity::ParityMemo;
 
@@ -144,11 +145,21 @@ impl CellMask {
         self.blocks.iter().map(|(&b, &w)| (b, w))
     }
 
-    /// A reader that remembers the last block it used.
+    /// A reader that remembers the last block it used of each parity.
     pub fn reader(&self) -> CellMaskReader<'_> {
         CellMaskReader {
             mask: self,
-            last: ParityMemo::new(0),
+            last: LastWords(ParityMemo::new(0)),
+        }
+    }
+
+    /// A reader that remembers the last block it used of each 32 × 32
+    /// window of blocks, for many reads that fan out from one place (see
+    /// [`crate::directmemo`]); it costs 16 KiB to set up.
+    pub fn window_reader(&self) -> CellMaskReader<'_, DirectMemo> {
+        CellMaskReader {
+            mask: self,
+            last: DirectMemo::default(),
         }
     }
 
@@ -162,17 +173,41 @@ impl CellMask {
     }
 }
 
-/// Reads a [`CellMask`] remembering the last word read of each parity of
-/// its block index (a cell's neighbourhood, and a run of cells along a
-/// beam, mostly lie in one block, and any 2 × 2 blocks have one of each
-/// parity).
-#[derive(Debug)]
-pub struct CellMaskReader<'a> {
-    mask: &'a CellMask,
-    last: ParityMemo<u64>,
+/// The words a [`CellMaskReader`] remembers, by block index ([`LastWords`],
+/// [`DirectMemo`]).
+pub trait WordMemo {
+    /// The word remembered for `block`, if any.
+    fn get(&self, block: (i32, i32)) -> Option<u64>;
+    /// Remembers `word` for `block` (perhaps in place of another).
+    fn set(&mut self, block: (i32, i32), word: u64);
 }
 
-impl CellMaskReader<'_> {
+/// The last word read of each parity of the block index
+/// ([`CellMask::reader`]).
+#[derive(Debug, Clone)]
+pub struct LastWords(ParityMemo<u64>);
+
+impl WordMemo for LastWords {
+    #[inline(always)]
+    fn get(&self, block: (i32, i32)) -> Option<u64> {
+        self.0.get(block)
+    }
+    #[inline(always)]
+    fn set(&mut self, block: (i32, i32), word: u64) {
+        self.0.set(block, word);
+    }
+}
+
+/// Reads a [`CellMask`] remembering words it read ([`LastWords`] by
+/// default: a cell's neighbourhood, and a run of cells along a beam, mostly
+/// lie in one block, and any 2 × 2 blocks have one of each parity).
+#[derive(Debug)]
+pub struct CellMaskReader<'a, M = LastWords> {
+    mask: &'a CellMask,
+    last: M,
+}
+
+impl<M: WordMemo> CellMaskReader<'_, M> {
     /// The word of `block` (0 when the mask has none).
     #[inline(always)]
     fn word(&mut self, block: (i32, i32)) -> u64 {

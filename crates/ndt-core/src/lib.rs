@@ -23,6 +23,7 @@ pub mod batch;
 pub mod cell;
 pub mod cellmask;
 pub mod degeneracy;
+pub mod directmemo;
 pub mod distributions;
 pub mod error;
 pub mod filter;

@@ -16,8 +16,8 @@ use std::sync::OnceLock;
 use crate::cellmask::{
     pair_bits, quarter_bits, quarter_mask, CellMask, CellMaskReader, BLOCK_BITS as WORD_BITS,
 };
+use crate::directmemo::DirectMemo;
 use crate::key::CellKey;
-use crate::pyramid::coarse_key;
 
 /// log2 of the side \[cells\] of the blocks with a bit each: a quarter of
 /// a word of the cells' mask (so a block empties when that quarter does).
@@ -108,7 +108,10 @@ impl Occupancy {
     /// An [`OccupancyProbe`] of these cells.
     pub fn probe(&self) -> OccupancyProbe<'_> {
         OccupancyProbe {
-            blocks: self.blocks.get_or_init(|| blocks_of(&self.cells)).reader(),
+            blocks: self
+                .blocks
+                .get_or_init(|| blocks_of(&self.cells))
+                .window_reader(),
         }
     }
 
@@ -120,11 +123,13 @@ impl Occupancy {
 
 /// Answers "may fine cell `key` hold points?" on blocks of 16 × 16 and of
 /// 4 × 4 fine cells ([`Occupancy::probe`]): `false` only when no cell of the
-/// block holds points. Remembers the words it read last, so a walk along a
-/// beam through empty space looks up one word per 32 × 32 cells.
+/// block holds points. Remembers the last word it read of each 32 × 32
+/// window of words ([`CellMask::window_reader`]: 20 × 20 m of 2 cm cells),
+/// so the walks of one scan, which all start at the sensor, look up most
+/// words once ([`crate::filter::walkmap`]).
 #[derive(Debug)]
 pub struct OccupancyProbe<'a> {
-    blocks: CellMaskReader<'a>,
+    blocks: CellMaskReader<'a, DirectMemo>,
 }
 
 impl OccupancyProbe<'_> {
@@ -154,24 +159,22 @@ impl OccupancyProbe<'_> {
 
     /// log2 of the side \[fine cells\] of the largest aligned block of 32 ×
     /// 32, 16 × 16, 8 × 8 or 4 × 4 fine cells holding `key` that holds no
-    /// points and not `last` (5, 4, 3 or 2); `None` when even the 4 × 4
-    /// block holds points or `last`. The four are one word of the blocks'
-    /// mask, a quarter of it, 2 × 2 of its bits and one bit: one look-up
+    /// points (5, 4, 3 or 2); `None` when even the 4 × 4 block holds points.
+    /// The four are one word of the blocks' mask, a quarter of it, 2 × 2 of its bits and one bit: one look-up
     /// answers them all (the §V walks ask this at every step,
     /// [`crate::filter::raywalk::walk_cells_in_skipping`]).
     #[inline]
-    pub fn empty_block(&mut self, key: CellKey, last: CellKey) -> Option<u32> {
+    pub fn empty_block(&mut self, key: CellKey) -> Option<u32> {
         let small = small_block(key);
         let (word, bit) = self.blocks.word_and_bit(small);
-        let apart = |b: i32| coarse_key(key, b as usize) != coarse_key(last, b as usize);
         // Largest first; each part's bits only when the larger one holds points.
-        let b = if word == 0 && apart(SMALL_BITS + WORD_BITS) {
+        let b = if word == 0 {
             SMALL_BITS + WORD_BITS
-        } else if word & quarter_bits(small) == 0 && apart(SMALL_BITS + WORD_BITS - 1) {
+        } else if word & quarter_bits(small) == 0 {
             SMALL_BITS + WORD_BITS - 1
-        } else if word & pair_bits(small) == 0 && apart(SMALL_BITS + 1) {
+        } else if word & pair_bits(small) == 0 {
             SMALL_BITS + 1
-        } else if word >> bit & 1 == 0 && apart(SMALL_BITS) {
+        } else if word >> bit & 1 == 0 {
             SMALL_BITS
         } else {
             return None;
@@ -229,16 +232,13 @@ mod tests {
                 };
                 assert_eq!(probe.may_hold(key), near(4), "{key:?}");
                 assert_eq!(probe.may_hold_inner(key), near(2), "{key:?}");
-                // The largest empty block without `last`, of 32 down to 4
-                // cells a side, from one word.
-                for last in [key, CellKey { ix: 3, iy: -5 }, CellKey { ix: -17, iy: 30 }] {
-                    let apart = |b: i32| (ix >> b, iy >> b) != (last.ix >> b, last.iy >> b);
-                    let want = [5, 4, 3, 2]
-                        .into_iter()
-                        .find(|&b| !near(b) && apart(b))
-                        .map(|b| b as u32);
-                    assert_eq!(probe.empty_block(key, last), want, "{key:?} {last:?}");
-                }
+                // The largest empty block, of 32 down to 4 cells a side,
+                // from one word.
+                let want = [5, 4, 3, 2]
+                    .into_iter()
+                    .find(|&b| !near(b))
+                    .map(|b| b as u32);
+                assert_eq!(probe.empty_block(key), want, "{key:?}");
             }
         }
     }

@@ -17,13 +17,13 @@ pub(crate) fn parity(index: (i32, i32)) -> usize {
 
 /// A tile index packed into one word (one compare).
 #[inline(always)]
-fn packed(index: (i32, i32)) -> u64 {
+pub(crate) fn packed(index: (i32, i32)) -> u64 {
     (u64::from(index.0 as u32) << 32) | u64::from(index.1 as u32)
 }
 
 /// No tile index packs to this: |index| ≤ 2²⁷ for keys within
 /// [`crate::key::MAX_INDEX`], never `i32::MIN`.
-const NEVER: u64 = 0x8000_0000_8000_0000;
+pub(crate) const NEVER: u64 = 0x8000_0000_8000_0000;
 
 /// Per parity: the packed index remembered ([`NEVER`]: none) and its value.
 #[derive(Debug, Clone, Copy)]

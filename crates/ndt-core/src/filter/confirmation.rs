@@ -22,9 +22,8 @@ use rustc_hash::FxHashMap;
 
 use crate::filter::areas::Area;
 use crate::filter::observation::CellTable;
-use crate::filter::raywalk::walk_cells_in_skipping;
+use crate::filter::walkmap::WalkMap;
 use crate::filter::Beam;
-use crate::grid::NdtGrid;
 use crate::key::CellKey;
 
 /// How many points on each side of a hit estimate the surface direction.
@@ -82,12 +81,13 @@ pub struct Pass {
 }
 
 /// §V step d for one beam from `sensor` to `hit` (map frame \[m\]): appends to
-/// `out` the map cells the beam passed through short of its hit — every cell
-/// the walk crosses up to `margin` \[m\] before the hit whose point mean lies
-/// within `pass_radius` of the beam and more than `margin` short of the hit —
-/// except cells of small objects (per `table`) beyond the reliable range.
+/// `out` the cells of `map` the beam passed through short of its hit — every
+/// cell the walk crosses up to `margin` \[m\] before the hit whose point mean
+/// lies within `pass_radius` of the beam and more than `margin` short of the
+/// hit — except cells of small objects (per `table`) beyond the reliable
+/// range.
 pub fn passed_cells(
-    grid: &NdtGrid,
+    map: &mut WalkMap<'_>,
     table: &CellTable,
     sensor: Vector2<f64>,
     hit: Vector2<f64>,
@@ -102,45 +102,37 @@ pub fn passed_cells(
     }
     let dir = ray / range;
     let reach = range - margin;
+    let grid = map.grid();
     let cell_size = grid.cell_size();
-    let mut occupied = grid.occupancy();
-    // The walk crosses the blocks the pyramid shows empty without visiting
-    // them; of the cells it visits, those the occupancy mask holds are looked
-    // up.
-    walk_cells_in_skipping(
-        sensor,
-        sensor + dir * reach,
-        cell_size,
-        grid.key_bounds(),
-        &mut grid.occupancy_probe(),
-        |key, _, _| {
-            if !occupied.contains(key) {
-                return true;
-            }
-            let Some(stats) = grid.stats(key) else {
-                return true;
-            };
-            if stats.count == 0 {
-                return true;
-            }
-            let mean = key.center(cell_size) + stats.sum / stats.points();
-            let rel = mean - sensor;
-            let along = rel.dot(&dir);
-            let side = dir.x * rel.y - dir.y * rel.x;
-            if along <= 0.0 || along >= reach || side.abs() > clearing.pass_radius {
-                return true;
-            }
-            let small = table.get(&key).is_some_and(|c| c.is_small());
-            if !small || Area::of(rel.norm(), clearing.reliable_range) == Area::Reliable {
-                out.push(Pass {
-                    key,
-                    small,
-                    left: side > 0.0,
-                });
-            }
-            true
-        },
-    );
+    // The walk crosses the blocks the occupancy shows empty without visiting
+    // them; of the cells it visits, the occupied ones are looked up.
+    map.walk(sensor, sensor + dir * reach, |key, occupied| {
+        if !occupied {
+            return true;
+        }
+        let Some(stats) = grid.stats(key) else {
+            return true;
+        };
+        if stats.count == 0 {
+            return true;
+        }
+        let mean = key.center(cell_size) + stats.sum / stats.points();
+        let rel = mean - sensor;
+        let along = rel.dot(&dir);
+        let side = dir.x * rel.y - dir.y * rel.x;
+        if along <= 0.0 || along >= reach || side.abs() > clearing.pass_radius {
+            return true;
+        }
+        let small = table.get(&key).is_some_and(|c| c.is_small());
+        if !small || Area::of(rel.norm(), clearing.reliable_range) == Area::Reliable {
+            out.push(Pass {
+                key,
+                small,
+                left: side > 0.0,
+            });
+        }
+        true
+    });
 }
 
 /// §V step d for a whole scan: the cells to remove given every beam's
@@ -164,7 +156,7 @@ pub fn cells_to_clear(passes: &[Pass]) -> Vec<CellKey> {
 mod tests {
     use super::*;
     use crate::filter::observation::CellInfo;
-    use crate::Pose2;
+    use crate::{NdtGrid, Pose2};
 
     fn setup() -> (NdtGrid, CellTable) {
         let mut grid = NdtGrid::new(0.02).unwrap();
@@ -188,7 +180,7 @@ mod tests {
         };
         let mut out = Vec::new();
         passed_cells(
-            &grid,
+            &mut WalkMap::new(&grid),
             &table,
             Vector2::zeros(),
             Vector2::new(2.0, 0.0),
@@ -206,7 +198,7 @@ mod tests {
         // One pass clears the big cell; the small one needs both sides.
         assert_eq!(cells_to_clear(&out), vec![key(0.301)]);
         passed_cells(
-            &grid,
+            &mut WalkMap::new(&grid),
             &table,
             Vector2::new(0.0, 0.004),
             Vector2::new(2.0, 0.004),
@@ -218,7 +210,7 @@ mod tests {
         // From farther back the small cell at 0.4 m is in Area 2 too.
         out.clear();
         passed_cells(
-            &grid,
+            &mut WalkMap::new(&grid),
             &table,
             Vector2::new(-0.2, 0.0),
             Vector2::new(2.0, 0.0),
@@ -242,7 +234,7 @@ mod tests {
         let mut out = Vec::new();
         // The hit 3 cm behind the big cell: within the 4 cm margin.
         passed_cells(
-            &grid,
+            &mut WalkMap::new(&grid),
             &table,
             Vector2::zeros(),
             Vector2::new(0.331, 0.001),
@@ -253,7 +245,7 @@ mod tests {
         assert!(out.is_empty());
         // A beam crossing the cell 8 mm beside the mean of its points.
         passed_cells(
-            &grid,
+            &mut WalkMap::new(&grid),
             &table,
             Vector2::new(0.0, 0.009),
             Vector2::new(2.0, 0.009),

@@ -10,7 +10,8 @@
 //! | c | [`observation`] | cells observed in fewer than 2 scans are deleted, checked every third scan |
 //! | d | [`confirmation`] | cells a new beam passed through short of its hit are free space and removed |
 //!
-//! [`raywalk`] is the cell traversal along a beam that b-2 and d share, and
+//! [`raywalk`] is the cell traversal along a beam that b-2 and d share,
+//! [`walkmap`] the map as one scan's walks read it, and
 //! [`objects`] groups the small-object cells into detected objects.
 
 use nalgebra::Vector2;
@@ -22,6 +23,7 @@ pub mod confirmation;
 pub mod objects;
 pub mod observation;
 pub mod raywalk;
+pub mod walkmap;
 
 /// One valid beam of a scan, in beam order.
 #[derive(Debug, Clone, Copy, PartialEq)]

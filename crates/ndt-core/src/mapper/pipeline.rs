@@ -11,6 +11,7 @@ use crate::filter::backshift::former_cell_short_of;
 use crate::filter::cluster::{behind_com, centre_of_mass, clusters, forefront_cell, is_small};
 use crate::filter::confirmation::{cells_to_clear, grazing_margin, passed_cells, Clearing};
 use crate::filter::observation::{check_due, CellInfo};
+use crate::filter::walkmap::WalkMap;
 use crate::filter::Beam;
 use crate::grid::NdtGrid;
 use crate::key::CellKey;
@@ -122,6 +123,10 @@ impl MapFilter {
                 }
             }
         }
+        // The walks of b-2 and d read the map as it was before this scan,
+        // through readers kept across the beams (filter/walkmap.rs).
+        let before: &NdtGrid = grid;
+        let mut walks: Option<WalkMap<'_>> = None;
         // §V step b-2: a small-cluster point in Area 2 behind a former cell
         // along its beam may be shifted backward: do not store it.
         if o.backshift_rejection {
@@ -129,7 +134,12 @@ impl MapFilter {
                 if keep[i]
                     && small[i]
                     && Area::of(beams[i].range, o.reliable_range) == Area::Suspicious
-                    && former_cell_short_of(grid, sensor, beams[i].world, o.backshift_window)
+                    && former_cell_short_of(
+                        walks.get_or_insert_with(|| WalkMap::new(before)),
+                        sensor,
+                        beams[i].world,
+                        o.backshift_window,
+                    )
                 {
                     keep[i] = false;
                     dropped.push((i, Dropped::Backshift));
@@ -145,6 +155,7 @@ impl MapFilter {
         // against the map as it was before this scan).
         let mut clear: Vec<CellKey> = Vec::new();
         if o.radial_confirmation {
+            let map = walks.get_or_insert_with(|| WalkMap::new(before));
             let mut passes = Vec::new();
             let clearing = Clearing {
                 pass_radius: o.pass_radius,
@@ -157,7 +168,7 @@ impl MapFilter {
                         let base = o.clear_margin.max(o.clear_margin_relative * beam.range);
                         let margin = grazing_margin(cluster, j, sensor, base);
                         passed_cells(
-                            grid,
+                            map,
                             &self.table,
                             sensor,
                             beam.world,
