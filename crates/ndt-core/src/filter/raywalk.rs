@@ -193,22 +193,24 @@ fn crossing(first: f64, d: f64, k: i64) -> f64 {
 }
 
 /// The first crossing `k ≥ from` of an axis ([`crossing`]; `d > 0`, or
-/// `d = 0` with `first` infinite) whose distance `c` is not
-/// `before(c, target)` (`target` finite), and that distance: estimated by a
-/// division, then corrected by the comparisons a count up from `from`
-/// makes, so the same `k` (the distances grow with `k`, and `before` holds
-/// below some `k` and fails from there on). Crossing a block of 32 cells on
-/// a slope near 1 then costs about two comparisons instead of 32.
+/// `d = 0` with `first` infinite; `inv_d = 1 / d`) whose distance `c` is not
+/// `before(c, target)` (`target` finite), and that distance: estimated as
+/// `(target − first) · inv_d`, then corrected by the comparisons a count up
+/// from `from` makes, so the same `k` (the distances grow with `k`, and
+/// `before` holds below some `k` and fails from there on). Crossing a block
+/// of 32 cells on a slope near 1 then costs about two comparisons instead of
+/// 32. A product, not a quotient: a division's latency made criterion's
+/// `odometry_step/181_beams_2cm` 4 % slower (BENCHMARK.md, "Speed",
+/// session 25).
 #[inline]
 fn first_not(
-    first: f64,
-    d: f64,
+    (first, d, inv_d): (f64, f64, f64),
     from: i64,
     target: f64,
     before: impl Fn(f64, f64) -> bool,
 ) -> (i64, f64) {
     // `as` saturates (and takes NaN to 0): any estimate is corrected below.
-    let mut k = (((target - first) / d) as i64).max(from);
+    let mut k = (((target - first) * inv_d) as i64).max(from);
     let mut c = crossing(first, d, k);
     if before(c, target) {
         loop {
@@ -268,6 +270,8 @@ fn walk_until(
     };
     let (step_x, first_x, delta_x) = axis(dir.x, from.x, key.ix);
     let (step_y, first_y, delta_y) = axis(dir.y, from.y, key.iy);
+    // For the estimates of `first_not` (a product is quicker than a quotient).
+    let (inv_x, inv_y) = (1.0 / delta_x, 1.0 / delta_y);
     // Crossings passed per axis, and the distance of the next one.
     let (mut kx, mut ky) = (0i64, 0i64);
     let (mut next_x, mut next_y) = (first_x, first_y);
@@ -320,11 +324,11 @@ fn walk_until(
             if let (true, Some(nx)) = (by_x, nx) {
                 kx += nx - 1;
                 next_x = crossing(first_x, delta_x, kx);
-                (ky, next_y) = first_not(first_y, delta_y, ky, next_x, |c, t| c < t);
+                (ky, next_y) = first_not((first_y, delta_y, inv_y), ky, next_x, |c, t| c < t);
             } else if let Some(ny) = ny {
                 ky += ny - 1;
                 next_y = crossing(first_y, delta_y, ky);
-                (kx, next_x) = first_not(first_x, delta_x, kx, next_y, |c, t| c <= t);
+                (kx, next_x) = first_not((first_x, delta_x, inv_x), kx, next_y, |c, t| c <= t);
             }
             // The exit distance of the block's last cell, then the step
             // out.
