@@ -192,15 +192,21 @@ fn crossing(first: f64, d: f64, k: i64) -> f64 {
     first + k as f64 * d
 }
 
+/// Crossings [`first_not`] counts one by one before it estimates.
+const COUNTED: usize = 4;
+
 /// The first crossing `k ≥ from` of an axis ([`crossing`]; `d > 0`, or
 /// `d = 0` with `first` infinite; `inv_d = 1 / d`) whose distance `c` is not
-/// `before(c, target)` (`target` finite), and that distance: estimated as
-/// `(target − first) · inv_d`, then corrected by the comparisons a count up
-/// from `from` makes, so the same `k` (the distances grow with `k`, and
+/// `before(c, target)` (`target` finite), and that distance. The first
+/// [`COUNTED`] are compared one by one (in a small block, or on a beam
+/// close to the other axis, that is all there is, and those comparisons do
+/// not wait on one another); beyond them `k` is estimated as
+/// `(target − first) · inv_d` and corrected by the comparisons a count
+/// would make, so it is the same `k` (the distances grow with `k`, and
 /// `before` holds below some `k` and fails from there on). Crossing a block
-/// of 32 cells on a slope near 1 then costs about two comparisons instead of
-/// 32. A product, not a quotient: a division's latency made criterion's
-/// `odometry_step/181_beams_2cm` 4 % slower (BENCHMARK.md, "Speed",
+/// of 32 cells on a slope near 1 then costs a few comparisons instead of
+/// 32. Estimating from the first crossing (with a division) cost
+/// criterion's `odometry_step/181_beams_2cm` 4 % (BENCHMARK.md, "Speed",
 /// session 25).
 #[inline]
 fn first_not(
@@ -209,9 +215,19 @@ fn first_not(
     target: f64,
     before: impl Fn(f64, f64) -> bool,
 ) -> (i64, f64) {
-    // `as` saturates (and takes NaN to 0): any estimate is corrected below.
-    let mut k = (((target - first) * inv_d) as i64).max(from);
+    let mut k = from;
     let mut c = crossing(first, d, k);
+    for _ in 0..COUNTED {
+        if !before(c, target) {
+            return (k, c);
+        }
+        k += 1;
+        c = crossing(first, d, k);
+    }
+    let from = k;
+    // `as` saturates (and takes NaN to 0): any estimate is corrected below.
+    k = (((target - first) * inv_d) as i64).max(from);
+    c = crossing(first, d, k);
     if before(c, target) {
         loop {
             k += 1;
