@@ -176,9 +176,11 @@ class OdometryConfig:
     background_mapper : bool, default True
         Update the mapper on a helper thread behind the loop: matching goes on while
         the §V elimination of the last inserted scan runs, and :attr:`Odometry.mapper`
-        waits for it. Poses and mapper are the same bit for bit either way; it uses a
-        second core (Intel log on 2 cores: BENCHMARK.md, "Speed"). Ignored with
-        ``match_filtered_map``.
+        waits for it. ``False``: on the loop's own thread, 8 inserted scans at a time
+        (:attr:`Odometry.mapper` first takes in the rest). Poses and mapper are the
+        same bit for bit either way; the default uses a second core (Intel log on 2
+        cores: BENCHMARK.md, "Speed"). Ignored with ``match_filtered_map`` (the mapper
+        then takes each scan at once).
     build_map : bool, default True
         Build the map (:attr:`Odometry.mapper`) at all. ``False``: poses only, as a
         scan-to-map odometry such as KISS-ICP gives them. The loop keeps the grid it

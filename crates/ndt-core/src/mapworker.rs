@@ -1,5 +1,5 @@
 //! The odometry loop's mapper (the §V elimination in front of its own grid),
-//! updated in line or on a helper thread behind the loop.
+//! updated on a helper thread behind the loop, or on the loop's own thread.
 //!
 //! The loop's poses do not depend on the mapper (unless it matches against
 //! the filtered map), so its updates can run while the loop matches the next
@@ -12,7 +12,13 @@
 //! checks of [`Mapper::insert_scan`] depend on nothing else), so a scan the
 //! mapper would refuse is refused before anything changes.
 //!
-//! Scans are handed over 8 at a time (`BATCH_LENGTH`). A process that forks
+//! Scans are handed over 8 at a time (`BATCH_LENGTH`), and a batch brings
+//! the mapper's coarser levels up to date once. On the loop's own thread
+//! (`OdometryConfig::background_mapper` off) the scans are batched the same
+//! way and each full batch runs at once, as a helper would run it: a scan
+//! at a time, the coarser levels took 9 % of the Intel loop (callgrind,
+//! BENCHMARK.md, "Speed", session 25). Only a loop that matches against the
+//! mapper's grid updates it scan by scan. A process that forks
 //! keeps only the forking thread: in the child the helper is gone, so the
 //! mapper is then updated in line, and batches the parent's helper still
 //! held are reported as lost ([`NdtError::MapperLost`], by the next insert)
@@ -126,7 +132,7 @@ fn serve(shared: &Shared, batches: Receiver<Vec<Job>>) {
     }
 }
 
-/// The mapper updated on a helper thread.
+/// The mapper updated in batches: on a helper thread, or on the caller's.
 pub(crate) struct Behind {
     shared: Arc<Shared>,
     /// An empty mapper with the same options and cell size: checks scans.
@@ -137,13 +143,17 @@ pub(crate) struct Behind {
     thread: Option<JoinHandle<()>>,
     /// The process the helper runs in (a forked child has no helper).
     pid: u32,
+    /// A helper thread was asked for (else the batches run on the caller's
+    /// thread).
+    threaded: bool,
 }
 
 impl Behind {
-    /// Starts the helper; `checker` is an empty mapper with `mapper`'s
-    /// options and cell size. When no thread can start, the batches run on
-    /// the caller's thread as they are handed over.
-    fn start(mapper: Mapper, checker: Mapper) -> Self {
+    /// Starts the helper when `threaded`; `checker` is an empty mapper with
+    /// `mapper`'s options and cell size. Without a helper (not asked for, or
+    /// no thread could start) the batches run on the caller's thread as they
+    /// are handed over.
+    fn start(mapper: Mapper, checker: Mapper, threaded: bool) -> Self {
         let shared = Arc::new(Shared {
             mapper: RwLock::new(mapper),
             state: Mutex::new(Progress::default()),
@@ -151,10 +161,14 @@ impl Behind {
         });
         let (tx, rx) = sync_channel(QUEUE_LENGTH);
         let theirs = Arc::clone(&shared);
-        let thread = std::thread::Builder::new()
-            .name("ndtgrid-mapper".into())
-            .spawn(move || serve(&theirs, rx))
-            .ok();
+        let thread = threaded
+            .then(|| {
+                std::thread::Builder::new()
+                    .name("ndtgrid-mapper".into())
+                    .spawn(move || serve(&theirs, rx))
+                    .ok()
+            })
+            .flatten();
         Self {
             shared,
             checker,
@@ -162,6 +176,7 @@ impl Behind {
             batches: thread.is_some().then_some(tx),
             thread,
             pid: std::process::id(),
+            threaded,
         }
     }
 
@@ -254,20 +269,33 @@ impl Drop for Behind {
     }
 }
 
-/// The loop's mapper: updated in line, or behind the loop on a helper thread.
+/// The loop's mapper: updated scan by scan in line, or in batches (behind
+/// the loop on a helper thread, or on the loop's thread).
 pub(crate) enum MapperHost {
     Inline(Mapper),
     Behind(Behind),
 }
 
+/// Where and how a [`MapperHost`] updates its mapper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Hosting {
+    /// Each scan at once, in line (a loop matching against the mapper's grid).
+    EachScan,
+    /// In batches on the loop's thread.
+    Batches,
+    /// In batches on a helper thread.
+    Helper,
+}
+
 impl MapperHost {
-    /// Hosts `mapper`, on a helper thread when `behind`.
-    pub(crate) fn new(mapper: Mapper, behind: bool) -> Result<Self> {
-        Ok(if behind {
-            let checker = Mapper::new(mapper.grid().cell_size(), *mapper.filter().options())?;
-            Self::Behind(Behind::start(mapper, checker))
-        } else {
-            Self::Inline(mapper)
+    /// Hosts `mapper` as `hosting` says.
+    pub(crate) fn new(mapper: Mapper, hosting: Hosting) -> Result<Self> {
+        Ok(match hosting {
+            Hosting::EachScan => Self::Inline(mapper),
+            Hosting::Batches | Hosting::Helper => {
+                let checker = Mapper::new(mapper.grid().cell_size(), *mapper.filter().options())?;
+                Self::Behind(Behind::start(mapper, checker, hosting == Hosting::Helper))
+            }
         })
     }
 
@@ -329,11 +357,6 @@ impl MapperHost {
             b.wait();
         }
     }
-
-    /// Whether the mapper runs behind the loop.
-    pub(crate) fn is_behind(&self) -> bool {
-        matches!(self, Self::Behind(_))
-    }
 }
 
 impl Clone for MapperHost {
@@ -341,14 +364,18 @@ impl Clone for MapperHost {
         let mapper = self.view().clone();
         match self {
             Self::Inline(_) => Self::Inline(mapper),
-            Self::Behind(b) => Self::Behind(Behind::start(mapper, b.checker.clone())),
+            Self::Behind(b) => Self::Behind(Behind::start(mapper, b.checker.clone(), b.threaded)),
         }
     }
 }
 
 impl fmt::Debug for MapperHost {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let kind = if self.is_behind() { "Behind" } else { "Inline" };
+        let kind = match self {
+            Self::Inline(_) => "Inline",
+            Self::Behind(b) if b.threaded => "Behind",
+            Self::Behind(_) => "Batches",
+        };
         f.debug_tuple(kind).field(&*self.view()).finish()
     }
 }
@@ -370,5 +397,54 @@ impl Deref for MapperView<'_> {
             Self::Inline(m) => m,
             Self::Locked(g) => g,
         }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::mapper::MapperOptions;
+
+    /// A scan of a wall 1 m ahead, 41 beams.
+    fn wall() -> (Vec<f64>, Vec<f64>) {
+        let angles: Vec<f64> = (0..41).map(|i| (f64::from(i) - 20.0) * 0.01).collect();
+        let ranges = angles.iter().map(|a| 1.0 / a.cos()).collect();
+        (ranges, angles)
+    }
+
+    /// On the loop's thread the scans wait in a batch of 8 and no thread
+    /// starts: a full batch is taken in at once, a read takes in the rest,
+    /// and the mapper is the one updated scan by scan.
+    #[test]
+    fn batches_on_the_loops_thread_equal_each_scan_at_once() {
+        let mapper = Mapper::new(0.02, MapperOptions::default()).unwrap();
+        let mut batched = MapperHost::new(mapper.clone(), Hosting::Batches).unwrap();
+        let mut each = MapperHost::new(mapper, Hosting::EachScan).unwrap();
+        let threadless = match &batched {
+            MapperHost::Behind(b) => b.thread.is_none() && !b.threaded,
+            MapperHost::Inline(_) => false,
+        };
+        assert!(threadless, "batches are hosted as a threadless Behind");
+        let (r, a) = wall();
+        let taken = |host: &MapperHost| match host {
+            MapperHost::Behind(b) => b.shared.mapper.read().unwrap().grid().len(),
+            MapperHost::Inline(m) => m.grid().len(),
+        };
+        for k in 0..11 {
+            let pose = Pose2::new(0.01 * f64::from(k), 0.0, 0.0);
+            let scan = batched.check_scan(&r, &a, None, pose).unwrap();
+            batched.update(scan, Vec::new()).unwrap();
+            let scan = each.check_scan(&r, &a, None, pose).unwrap();
+            each.update(scan, Vec::new()).unwrap();
+            // Nothing until the eighth scan, then the first 8 at once.
+            assert_eq!(taken(&batched) > 0, k >= 7, "scan {k}");
+        }
+        assert_eq!(
+            batched.view().to_bytes().unwrap(),
+            each.view().to_bytes().unwrap()
+        );
+        assert_eq!(taken(&batched), taken(&each));
+        assert_eq!(format!("{batched:?}").split('(').next(), Some("Batches"));
     }
 }

@@ -22,7 +22,7 @@ use std::collections::VecDeque;
 use crate::error::{check_bound, check_finite, NdtError, Result};
 use crate::grid::NdtGrid;
 use crate::mapper::{Mapper, MapperOptions};
-use crate::mapworker::{MapperHost, MapperView};
+use crate::mapworker::{Hosting, MapperHost, MapperView};
 use crate::matcher::{levels_up_to, MatchOptions, MatchResult};
 use crate::ranges::BeamDirections;
 use crate::se2::Pose2;
@@ -231,12 +231,14 @@ pub struct OdometryConfig {
     /// Update the mapper ([`Odometry::mapper`]) on a helper thread, behind
     /// the loop, instead of in line (see [`crate::mapworker`]): the loop goes
     /// on matching while the §V elimination of the last inserted scan runs,
-    /// and reading the mapper waits for it. The poses and the mapper are the
+    /// and reading the mapper waits for it. Off: on the loop's own thread, 8
+    /// inserted scans at a time, as the helper takes them (reading the
+    /// mapper first takes in the rest). The poses and the mapper are the
     /// same bit for bit either way. On by default: it takes one more core
     /// (the helper sleeps when idle) and the Intel log runs in less time on
     /// 2 cores (BENCHMARK.md, "Speed"). Ignored with
     /// [`OdometryConfig::match_filtered_map`] (the loop then matches against
-    /// the mapper's grid, so it must be up to date).
+    /// the mapper's grid, so it takes each scan at once).
     pub background_mapper: bool,
     /// Build the map at all ([`Odometry::mapper`]). Off: poses only, as a
     /// scan-to-map odometry such as KISS-ICP gives them. The loop keeps its
@@ -440,7 +442,13 @@ impl Odometry {
             grid: NdtGrid::new(config.cell_size)?,
             mapper: MapperHost::new(
                 Mapper::new(config.cell_size, mapper_options)?,
-                config.background_mapper && config.build_map && !config.match_filtered_map,
+                if !config.build_map || config.match_filtered_map {
+                    Hosting::EachScan
+                } else if config.background_mapper {
+                    Hosting::Helper
+                } else {
+                    Hosting::Batches
+                },
             )?,
             config,
             poses: Vec::new(),
