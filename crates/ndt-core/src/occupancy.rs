@@ -160,9 +160,9 @@ impl OccupancyProbe<'_> {
     /// log2 of the side \[fine cells\] of the largest aligned block of 32 ×
     /// 32, 16 × 16, 8 × 8 or 4 × 4 fine cells holding `key` that holds no
     /// points (5, 4, 3 or 2); `None` when even the 4 × 4 block holds points.
-    /// The four are one word of the blocks' mask, a quarter of it, 2 × 2 of its bits and one bit: one look-up
-    /// answers them all (the §V walks ask this at every step,
-    /// [`crate::filter::raywalk::walk_cells_in_skipping`]).
+    /// The four are one word of the blocks' mask, a quarter of it, 2 × 2 of
+    /// its bits and one bit: one look-up answers them all (the §V walks ask
+    /// this at every step, [`crate::filter::raywalk::walk_cells_in_skipping`]).
     #[inline]
     pub fn empty_block(&mut self, key: CellKey) -> Option<u32> {
         let small = small_block(key);

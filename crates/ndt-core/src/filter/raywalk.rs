@@ -196,11 +196,12 @@ fn crossing(first: f64, d: f64, k: i64) -> f64 {
 const COUNTED: usize = 4;
 
 /// The first crossing `k ≥ from` of an axis ([`crossing`]; `d > 0`, or
-/// `d = 0` with `first` infinite; `inv_d = 1 / d`) whose distance `c` is not
-/// `before(c, target)` (`target` finite), and that distance. The first
-/// [`COUNTED`] are compared one by one (in a small block, or on a beam
-/// close to the other axis, that is all there is, and those comparisons do
-/// not wait on one another); beyond them `k` is estimated as
+/// `d = 0` with `first` infinite; `inv_d ≈ 1 / d`, for the estimate only;
+/// `at`: crossing `from`'s distance, which the caller holds) whose distance
+/// `c` is not `before(c, target)` (`target` finite), and that distance. The
+/// first [`COUNTED`] are compared one by one (in a small block, or on a
+/// beam close to the other axis, that is all there is, and those
+/// comparisons do not wait on one another); beyond them `k` is estimated as
 /// `(target − first) · inv_d` and corrected by the comparisons a count
 /// would make, so it is the same `k` (the distances grow with `k`, and
 /// `before` holds below some `k` and fails from there on). Crossing a block
@@ -211,12 +212,11 @@ const COUNTED: usize = 4;
 #[inline]
 fn first_not(
     (first, d, inv_d): (f64, f64, f64),
-    from: i64,
+    (from, at): (i64, f64),
     target: f64,
     before: impl Fn(f64, f64) -> bool,
 ) -> (i64, f64) {
-    let mut k = from;
-    let mut c = crossing(first, d, k);
+    let (mut k, mut c) = (from, at);
     for _ in 0..COUNTED {
         if !before(c, target) {
             return (k, c);
@@ -271,7 +271,8 @@ fn walk_until(
     }
     let dir = delta / length;
     // Per axis: the step (±1), the distance to the first boundary crossing,
-    // and the distance between crossings.
+    // and the distance between crossings, with its reciprocal `|d| / cell`
+    // for the estimates of `first_not` (0 where never crossed).
     let axis = |d: f64, origin: f64, index: i32| -> (i32, f64, f64) {
         if d > 0.0 {
             let boundary = (f64::from(index) + 1.0) * cell_size;
@@ -286,8 +287,7 @@ fn walk_until(
     };
     let (step_x, first_x, delta_x) = axis(dir.x, from.x, key.ix);
     let (step_y, first_y, delta_y) = axis(dir.y, from.y, key.iy);
-    // For the estimates of `first_not` (a product is quicker than a quotient).
-    let (inv_x, inv_y) = (1.0 / delta_x, 1.0 / delta_y);
+    let (inv_x, inv_y) = (dir.x.abs() * inv, dir.y.abs() * inv);
     // Crossings passed per axis, and the distance of the next one.
     let (mut kx, mut ky) = (0i64, 0i64);
     let (mut next_x, mut next_y) = (first_x, first_y);
@@ -340,11 +340,17 @@ fn walk_until(
             if let (true, Some(nx)) = (by_x, nx) {
                 kx += nx - 1;
                 next_x = crossing(first_x, delta_x, kx);
-                (ky, next_y) = first_not((first_y, delta_y, inv_y), ky, next_x, |c, t| c < t);
+                (ky, next_y) =
+                    first_not((first_y, delta_y, inv_y), (ky, next_y), next_x, |c, t| {
+                        c < t
+                    });
             } else if let Some(ny) = ny {
                 ky += ny - 1;
                 next_y = crossing(first_y, delta_y, ky);
-                (kx, next_x) = first_not((first_x, delta_x, inv_x), kx, next_y, |c, t| c <= t);
+                (kx, next_x) =
+                    first_not((first_x, delta_x, inv_x), (kx, next_x), next_y, |c, t| {
+                        c <= t
+                    });
             }
             // The exit distance of the block's last cell, then the step
             // out.
