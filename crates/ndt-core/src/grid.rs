@@ -57,20 +57,6 @@ pub(crate) struct StagedScan {
     points: Vec<(CellKey, Vector2<f64>)>,
 }
 
-impl StagedScan {
-    /// The cells of the scan's points, each once, in the order of their
-    /// first point (the order [`NdtGrid::insert`] returns them in).
-    pub(crate) fn cells(&self) -> Vec<CellKey> {
-        // The key set the pyramid's insert dedups with (crate::scratch).
-        let mut seen = crate::scratch::KeySet::default();
-        self.points
-            .iter()
-            .map(|(k, _)| *k)
-            .filter(|k| seen.insert(*k))
-            .collect()
-    }
-}
-
 /// A sparse, unbounded NDT grid map (§III-B).
 ///
 /// Memory grows with the mapped area (occupied cells), not with the number of

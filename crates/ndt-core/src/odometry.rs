@@ -419,8 +419,10 @@ pub struct Odometry {
     /// Where the map and the matching grid took their last scans.
     last_insert: Option<Pose2>,
     last_grid_insert: Option<Pose2>,
-    /// The memory bounds of the map (the mapper's) and of the matching grid.
-    window: CellWindow,
+    /// Scans added to the map (its memory bound is kept with the mapper,
+    /// [`crate::mapworker`]).
+    map_insertions: u64,
+    /// The matching grid's memory bound.
     grid_window: CellWindow,
     /// Score of eq. (1) per point of the last [`GATE_HISTORY`] accepted
     /// matches (see [`OdometryConfig::coarse_rotation_gate`]).
@@ -449,13 +451,14 @@ impl Odometry {
                 } else {
                     Hosting::Batches
                 },
+                config.map_window,
             )?,
             config,
             poses: Vec::new(),
             last_odom: None,
             last_insert: None,
             last_grid_insert: None,
-            window: CellWindow::default(),
+            map_insertions: 0,
             grid_window: CellWindow::default(),
             scores: VecDeque::with_capacity(GATE_HISTORY + 1),
             beams: BeamDirections::default(),
@@ -507,7 +510,7 @@ impl Odometry {
     /// Scans added to the map so far (0 without
     /// [`OdometryConfig::build_map`]).
     pub fn insertions(&self) -> u64 {
-        self.window.scans()
+        self.map_insertions
     }
 
     /// Scans the matching grid took so far
@@ -807,27 +810,23 @@ impl Odometry {
         } else {
             None
         };
-        // The scan's cells (the same lattice for both maps), checked before
-        // either map changes.
-        let staged = self.grid.stage(points, pose)?;
-        let touched = if into_grid {
+        if into_grid {
+            // The scan's cells, checked before the grid changes (the mapper
+            // checked the same points on the same lattice above).
+            let staged = self.grid.stage(points, pose)?;
             let keys = self.grid.insert_staged(staged);
-            let touched = checked.is_some().then(|| keys.clone());
             let stale = self.grid_window.record(keys, self.config.match_map_window);
             self.grid.remove_cells(&stale);
             self.last_grid_insert = Some(pose);
-            touched
-        } else {
-            Some(staged.cells())
-        };
-        let (Some(checked), Some(touched)) = (checked, touched) else {
+        }
+        let Some(checked) = checked else {
             return Ok(());
         };
-        let stale = self.window.record(touched, self.config.map_window);
+        self.map_insertions += 1;
         self.last_insert = Some(pose);
-        // The mapper takes the scan, then loses its stale cells: in line, or
-        // queued behind the loop as one job.
-        self.mapper.update(checked, stale)
+        // The mapper takes the scan, then loses the cells its window drops:
+        // in line, or queued behind the loop as one job (crate::mapworker).
+        self.mapper.update(checked)
     }
 
     fn valid_points(&mut self, ranges: &[f64], angles: &[f64]) -> Result<Vec<[f64; 2]>> {

@@ -82,6 +82,15 @@ impl KeySet {
     }
 }
 
+/// `keys` each once, in the order of their first appearance (`seen`: an
+/// empty set, left holding them).
+pub(crate) fn first_touch(keys: impl Iterator<Item = CellKey>, seen: &mut KeySet) -> Vec<CellKey> {
+    // Room for every key at once, rather than growth by doubling.
+    let mut out = Vec::with_capacity(keys.size_hint().1.unwrap_or(0));
+    out.extend(keys.filter(|&k| seen.insert(k)));
+    out
+}
+
 /// A reusable set of keys (see the module docs).
 #[derive(Debug, Default)]
 pub(crate) struct KeyScratch(KeySet);

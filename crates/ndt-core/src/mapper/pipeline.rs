@@ -16,6 +16,7 @@ use crate::filter::Beam;
 use crate::grid::NdtGrid;
 use crate::key::CellKey;
 use crate::ranges::check_beams;
+use crate::scratch::{first_touch, KeySet};
 use crate::se2::Pose2;
 
 /// A scan that passed [`MapFilter::check_scan`]: its valid beams and pose.
@@ -23,6 +24,18 @@ use crate::se2::Pose2;
 pub(crate) struct CheckedScan {
     beams: Vec<Beam>,
     pose: Pose2,
+}
+
+impl CheckedScan {
+    /// The cells the beams end in (on the lattice of cells `1 / inv_cell`
+    /// wide), each once, in beam order: the cells of the same points staged
+    /// by [`NdtGrid::stage`], bit for bit ([`Beam::along`] maps a point as
+    /// `stage` does, and a checked beam's cell exists). `seen`: an empty
+    /// set to find repeats with.
+    pub(crate) fn cells(&self, inv_cell: f64, seen: &mut KeySet) -> Vec<CellKey> {
+        let keys = self.beams.iter();
+        first_touch(keys.map(|b| CellKey::of_flagged(b.world, inv_cell).0), seen)
+    }
 }
 
 /// Which step dropped a point of the new scan.
