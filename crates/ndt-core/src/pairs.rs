@@ -18,6 +18,7 @@
 //! evaluation gives the same bits whatever was kept before it.
 
 use std::borrow::Borrow;
+use std::cell::RefCell;
 
 use multiversion::multiversion;
 use nalgebra::Vector2;
@@ -50,6 +51,31 @@ struct Known {
     paired: u8,
 }
 
+/// Its vectors go back to the thread's spares (see [`Storage`]).
+impl Drop for ScanPairs<'_> {
+    fn drop(&mut self) {
+        if self.chunks.capacity() > SPARE_CHUNKS {
+            return;
+        }
+        let storage = Storage {
+            chunks: std::mem::take(&mut self.chunks),
+            keys: std::mem::take(&mut self.keys),
+            known: std::mem::take(&mut self.known),
+            fresh: std::mem::take(&mut self.fresh),
+            valid: std::mem::take(&mut self.valid),
+            same: std::mem::take(&mut self.same),
+        };
+        // A thread being torn down keeps nothing.
+        let _ = SPARE.try_with(|s| {
+            if let Ok(mut spare) = s.try_borrow_mut() {
+                if spare.len() < SPARE_STORAGES {
+                    spare.push(storage);
+                }
+            }
+        });
+    }
+}
+
 /// The points of a scan (optionally weighted, see [`crate::reduce`]) with
 /// their pairs in one [`Distributions`] (see the module docs).
 #[derive(Debug)]
@@ -69,21 +95,56 @@ pub struct ScanPairs<'a> {
     same: Vec<u8>,
 }
 
+/// The vectors of a dropped [`ScanPairs`], for the next one made on the
+/// same thread: the odometry loop makes 8 a scan, and each allocation on
+/// its thread may wait for the allocator's lock while the mapper's helper
+/// holds it (glibc; BENCHMARK.md, "Speed", session 26).
+#[derive(Default)]
+struct Storage {
+    chunks: Vec<Chunk>,
+    keys: Vec<KeyLanes>,
+    known: Vec<Known>,
+    fresh: Vec<KeyLanes>,
+    valid: Vec<u8>,
+    same: Vec<u8>,
+}
+
+/// Storages a thread keeps at most.
+const SPARE_STORAGES: usize = 8;
+
+/// Chunks a kept storage holds at most (4096 points, about 0.5 MB; the
+/// Intel log's scans take 23): a thread keeps at most `SPARE_STORAGES` of
+/// them.
+const SPARE_CHUNKS: usize = 512;
+
+thread_local! {
+    static SPARE: RefCell<Vec<Storage>> = const { RefCell::new(Vec::new()) };
+}
+
+/// `v` emptied, then `n` copies of `x`: what `vec![x; n]` holds.
+fn filled<T: Clone>(mut v: Vec<T>, n: usize, x: T) -> Vec<T> {
+    v.clear();
+    v.resize(n, x);
+    v
+}
+
 impl<'a> ScanPairs<'a> {
     /// `points` (scan frame \[m\]), each standing for `weights[i]` points (1
     /// without weights), with nothing paired yet.
     pub fn new(points: &'a [[f64; 2]], weights: Option<&'a [f64]>) -> Self {
         let n = points.len().div_ceil(LANES);
+        let spare = SPARE.try_with(|s| s.try_borrow_mut().ok()?.pop());
+        let s = spare.ok().flatten().unwrap_or_default();
         let mut pairs = Self {
             points,
             weights,
             source: None,
-            chunks: vec![Chunk::default(); n],
-            keys: vec![KeyLanes::default(); n],
-            known: vec![Known::default(); n],
-            fresh: vec![KeyLanes::default(); n],
-            valid: vec![0; n],
-            same: vec![0; n],
+            chunks: filled(s.chunks, n, Chunk::default()),
+            keys: filled(s.keys, n, KeyLanes::default()),
+            known: filled(s.known, n, Known::default()),
+            fresh: filled(s.fresh, n, KeyLanes::default()),
+            valid: filled(s.valid, n, 0),
+            same: filled(s.same, n, 0),
         };
         // Fresh chunks hold zeros, pairs included: only the points are set.
         pairs.set_points(points, weights);
@@ -529,6 +590,73 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Pairs made from a dropped one's storage (a larger scan's, paired,
+    /// with other weights) evaluate to the bits of pairs made on a thread
+    /// with nothing kept; a thread keeps at most `SPARE_STORAGES`, and none
+    /// larger than `SPARE_CHUNKS`.
+    #[test]
+    fn reused_storage_gives_the_bits_of_new_storage() {
+        let mut grid = NdtGrid::new(0.02).unwrap();
+        let wall: Vec<[f64; 2]> = (0..500)
+            .map(|i| [f64::from(i) * 0.004, 0.5 + 0.002 * f64::from(i % 5)])
+            .collect();
+        grid.insert(&wall, Pose2::identity()).unwrap();
+        let options = DistOptions {
+            expansion: 10.0,
+            fuse_minority: true,
+            sigma_floor: 0.005,
+            shape_cell: 0.0,
+        };
+        let d = grid.distributions(0, options).unwrap();
+        let inv = 1.0 / d.cell_size();
+        let big: Vec<[f64; 2]> = (0..333)
+            .map(|i| [f64::from(i) * 0.005, 0.49 + 0.001 * f64::from(i % 3)])
+            .collect();
+        let heavy: Vec<f64> = (0..333).map(|i| 2.0 + f64::from(i % 4)).collect();
+        // Every third point far from the wall: no pair, so its lane must
+        // add zeros whatever the storage held.
+        let small: Vec<[f64; 2]> = (0..45)
+            .map(|i| {
+                [
+                    0.3 + f64::from(i) * 0.01,
+                    if i % 3 == 0 { 5.0 } else { 0.51 },
+                ]
+            })
+            .collect();
+        let pose = Pose2::new(0.003, -0.002, 0.001);
+        let eval = |pts: &[[f64; 2]], order| {
+            ScanPairs::new(pts, None).evaluate(&d, pose, inv, Some(2), order)
+        };
+        let fresh = std::thread::scope(|s| {
+            s.spawn(|| [Order::Value, Order::Derivatives].map(|o| eval(&small, o)))
+                .join()
+                .unwrap()
+        });
+        for _ in 0..3 {
+            let mut used = ScanPairs::new(&big, Some(&heavy));
+            assert!(
+                used.evaluate(&d, pose, inv, Some(2), Order::Derivatives)
+                    .terms
+                    .matched
+                    > 0
+            );
+        }
+        assert!(SPARE.with(|s| s.borrow().len()) > 0, "the storage was kept");
+        for (o, want) in [Order::Value, Order::Derivatives].into_iter().zip(fresh) {
+            assert_eq!(eval(&small, o), want);
+        }
+        // Bounds: many alive at once, then dropped; and one too large.
+        let many: Vec<_> = (0..3 * SPARE_STORAGES)
+            .map(|_| ScanPairs::new(&small, None))
+            .collect();
+        drop(many);
+        assert_eq!(SPARE.with(|s| s.borrow().len()), SPARE_STORAGES);
+        SPARE.with(|s| s.borrow_mut().clear());
+        let huge = vec![[0.0, 0.0]; (SPARE_CHUNKS + 1) * LANES];
+        drop(ScanPairs::new(&huge, None));
+        assert_eq!(SPARE.with(|s| s.borrow().len()), 0);
     }
 
     /// Along a random walk of poses (points crossing cells, leaving the map,
