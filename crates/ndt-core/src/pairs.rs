@@ -51,20 +51,13 @@ struct Known {
     paired: u8,
 }
 
-/// Its vectors go back to the thread's spares (see [`Storage`]).
+/// Its vectors go back to the thread's spares (the private `Storage`).
 impl Drop for ScanPairs<'_> {
     fn drop(&mut self) {
-        if self.chunks.capacity() > SPARE_CHUNKS {
+        if self.store.chunks.capacity() > SPARE_CHUNKS {
             return;
         }
-        let storage = Storage {
-            chunks: std::mem::take(&mut self.chunks),
-            keys: std::mem::take(&mut self.keys),
-            known: std::mem::take(&mut self.known),
-            fresh: std::mem::take(&mut self.fresh),
-            valid: std::mem::take(&mut self.valid),
-            same: std::mem::take(&mut self.same),
-        };
+        let storage = std::mem::take(&mut self.store);
         // A thread being torn down keeps nothing.
         let _ = SPARE.try_with(|s| {
             if let Ok(mut spare) = s.try_borrow_mut() {
@@ -85,6 +78,15 @@ pub struct ScanPairs<'a> {
     /// The address of the distributions the kept pairs come from (an
     /// identity only; they outlive the pairs).
     source: Option<usize>,
+    store: Storage,
+}
+
+/// The vectors of a [`ScanPairs`]. A dropped one's go to the next one made
+/// on the same thread: the odometry loop makes 8 a scan, and each
+/// allocation on its thread may wait for the allocator's lock while the
+/// mapper's helper holds it (glibc; BENCHMARK.md, "Speed", session 26).
+#[derive(Debug, Default)]
+struct Storage {
     chunks: Vec<Chunk>,
     keys: Vec<KeyLanes>,
     known: Vec<Known>,
@@ -95,18 +97,23 @@ pub struct ScanPairs<'a> {
     same: Vec<u8>,
 }
 
-/// The vectors of a dropped [`ScanPairs`], for the next one made on the
-/// same thread: the odometry loop makes 8 a scan, and each allocation on
-/// its thread may wait for the allocator's lock while the mapper's helper
-/// holds it (glibc; BENCHMARK.md, "Speed", session 26).
-#[derive(Default)]
-struct Storage {
-    chunks: Vec<Chunk>,
-    keys: Vec<KeyLanes>,
-    known: Vec<Known>,
-    fresh: Vec<KeyLanes>,
-    valid: Vec<u8>,
-    same: Vec<u8>,
+impl Storage {
+    /// A spare of this thread's, or a new one.
+    fn spare() -> Self {
+        let spare = SPARE.try_with(|s| s.try_borrow_mut().ok()?.pop());
+        spare.ok().flatten().unwrap_or_default()
+    }
+
+    /// Emptied, then `n` chunks of each, as new vectors hold them.
+    fn filled(mut self, n: usize) -> Self {
+        fill(&mut self.chunks, n, Chunk::default());
+        fill(&mut self.keys, n, KeyLanes::default());
+        fill(&mut self.known, n, Known::default());
+        fill(&mut self.fresh, n, KeyLanes::default());
+        fill(&mut self.valid, n, 0);
+        fill(&mut self.same, n, 0);
+        self
+    }
 }
 
 /// Storages a thread keeps at most.
@@ -122,10 +129,9 @@ thread_local! {
 }
 
 /// `v` emptied, then `n` copies of `x`: what `vec![x; n]` holds.
-fn filled<T: Clone>(mut v: Vec<T>, n: usize, x: T) -> Vec<T> {
+fn fill<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
     v.clear();
     v.resize(n, x);
-    v
 }
 
 impl<'a> ScanPairs<'a> {
@@ -133,18 +139,11 @@ impl<'a> ScanPairs<'a> {
     /// without weights), with nothing paired yet.
     pub fn new(points: &'a [[f64; 2]], weights: Option<&'a [f64]>) -> Self {
         let n = points.len().div_ceil(LANES);
-        let spare = SPARE.try_with(|s| s.try_borrow_mut().ok()?.pop());
-        let s = spare.ok().flatten().unwrap_or_default();
         let mut pairs = Self {
             points,
             weights,
             source: None,
-            chunks: filled(s.chunks, n, Chunk::default()),
-            keys: filled(s.keys, n, KeyLanes::default()),
-            known: filled(s.known, n, Known::default()),
-            fresh: filled(s.fresh, n, KeyLanes::default()),
-            valid: filled(s.valid, n, 0),
-            same: filled(s.same, n, 0),
+            store: Storage::spare().filled(n),
         };
         // Fresh chunks hold zeros, pairs included: only the points are set.
         pairs.set_points(points, weights);
@@ -155,7 +154,7 @@ impl<'a> ScanPairs<'a> {
     /// [`ScanPairs::new`]; any more are left out), with nothing paired.
     fn bind(&mut self, points: &'a [[f64; 2]], weights: Option<&'a [f64]>) {
         self.set_points(points, weights);
-        for ch in &mut self.chunks {
+        for ch in &mut self.store.chunks {
             for l in 0..LANES {
                 ch.clear_pair(l);
             }
@@ -165,14 +164,14 @@ impl<'a> ScanPairs<'a> {
     /// The points of the chunks (padding lanes at the origin; with no pair
     /// they add exact zeros), leaving the pairs' columns as they are.
     fn set_points(&mut self, points: &'a [[f64; 2]], weights: Option<&'a [f64]>) {
-        let n = points.len().div_ceil(LANES).min(self.keys.len());
+        let n = points.len().div_ceil(LANES).min(self.store.keys.len());
         self.points = points
             .get(..(n * LANES).min(points.len()))
             .unwrap_or(points);
         self.weights = weights;
         self.source = None;
-        self.chunks.truncate(n);
-        for (c, ch) in self.chunks.iter_mut().enumerate() {
+        self.store.chunks.truncate(n);
+        for (c, ch) in self.store.chunks.iter_mut().enumerate() {
             for l in 0..LANES {
                 let p = self.points.get(c * LANES + l).copied().unwrap_or([0.0; 2]);
                 ch.x[l] = p[0];
@@ -212,24 +211,24 @@ impl<'a> ScanPairs<'a> {
     ) -> usize {
         let source = std::ptr::from_ref(dists) as usize;
         if self.source != Some(source) {
-            self.known.fill(Known::default());
+            self.store.known.fill(Known::default());
             self.source = Some(source);
         }
         let (s, c) = scan.sin_cos;
         cell_keys(
-            &self.chunks,
+            &self.store.chunks,
             [s, c, scan.pose.x, scan.pose.y, inv_cell],
-            &self.keys,
-            &mut self.fresh,
-            &mut self.valid,
-            &mut self.same,
+            &self.store.keys,
+            &mut self.store.fresh,
+            &mut self.store.valid,
+            &mut self.store.same,
         );
         let matched = dists.visit(Refresh {
             pairs: self,
             scan,
             search_radius,
         });
-        scan.add(&self.chunks, sums);
+        scan.add(&self.store.chunks, sums);
         matched
     }
 }
@@ -358,12 +357,15 @@ impl CursorVisitor for Refresh<'_, '_> {
         let ScanPairs {
             points,
             weights,
-            chunks,
-            keys,
-            known,
-            fresh,
-            valid,
-            same,
+            store:
+                Storage {
+                    chunks,
+                    keys,
+                    known,
+                    fresh,
+                    valid,
+                    same,
+                },
             ..
         } = self.pairs;
         let (pose, sin_cos) = (self.scan.pose, self.scan.sin_cos);
@@ -452,6 +454,16 @@ mod tests {
     use crate::neighbor::nearest_in_rings_with;
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
+
+    /// The tests' distributions: the paper's fusion, widened by 10.
+    fn wide_options() -> DistOptions {
+        DistOptions {
+            expansion: 10.0,
+            fuse_minority: true,
+            sigma_floor: 0.005,
+            shape_cell: 0.0,
+        }
+    }
 
     /// A fresh block of the pairs `pair` gives, point by point in order: the
     /// reference for the kept pairs (same pairs; lanes by pair, not by point,
@@ -603,12 +615,7 @@ mod tests {
             .map(|i| [f64::from(i) * 0.004, 0.5 + 0.002 * f64::from(i % 5)])
             .collect();
         grid.insert(&wall, Pose2::identity()).unwrap();
-        let options = DistOptions {
-            expansion: 10.0,
-            fuse_minority: true,
-            sigma_floor: 0.005,
-            shape_cell: 0.0,
-        };
+        let options = wide_options();
         let d = grid.distributions(0, options).unwrap();
         let inv = 1.0 / d.cell_size();
         let big: Vec<[f64; 2]> = (0..333)
@@ -676,12 +683,7 @@ mod tests {
             .chain((0..300).map(|i| [0.2 + 0.0013 * f64::from(i % 7), f64::from(i) * 0.004]))
             .collect();
         grid.insert(&wall, Pose2::identity()).unwrap();
-        let options = DistOptions {
-            expansion: 10.0,
-            fuse_minority: true,
-            sigma_floor: 0.005,
-            shape_cell: 0.0,
-        };
+        let options = wide_options();
         let levels: Vec<_> = (0..2)
             .map(|l| grid.distributions(l, options).unwrap())
             .collect();
