@@ -4,8 +4,8 @@
 //! The loop's poses do not depend on the mapper (unless it matches against
 //! the filtered map), so its updates can run while the loop matches the next
 //! scans: each insertion (with the removals it brings) is queued, in order,
-//! to one helper thread, and reading the mapper waits until the queue is empty. The mapper
-//! is then the same, bit for bit, as one updated in line.
+//! to one helper thread, and reading the mapper waits until the queue is
+//! empty. The mapper is then the same, bit for bit, as one updated in line.
 //!
 //! A queued insertion cannot fail: it is checked first, on the caller's
 //! thread, against an empty mapper with the same options and cell size (the

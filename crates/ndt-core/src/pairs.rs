@@ -51,24 +51,6 @@ struct Known {
     paired: u8,
 }
 
-/// Its vectors go back to the thread's spares (the private `Storage`).
-impl Drop for ScanPairs<'_> {
-    fn drop(&mut self) {
-        if self.store.chunks.capacity() > SPARE_CHUNKS {
-            return;
-        }
-        let storage = std::mem::take(&mut self.store);
-        // A thread being torn down keeps nothing.
-        let _ = SPARE.try_with(|s| {
-            if let Ok(mut spare) = s.try_borrow_mut() {
-                if spare.len() < SPARE_STORAGES {
-                    spare.push(storage);
-                }
-            }
-        });
-    }
-}
-
 /// The points of a scan (optionally weighted, see [`crate::reduce`]) with
 /// their pairs in one [`Distributions`] (see the module docs).
 #[derive(Debug)]
@@ -126,6 +108,24 @@ const SPARE_CHUNKS: usize = 512;
 
 thread_local! {
     static SPARE: RefCell<Vec<Storage>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Its vectors go back to the thread's spares (`Storage`, above).
+impl Drop for ScanPairs<'_> {
+    fn drop(&mut self) {
+        if self.store.chunks.capacity() > SPARE_CHUNKS {
+            return;
+        }
+        let storage = std::mem::take(&mut self.store);
+        // A thread being torn down keeps nothing.
+        let _ = SPARE.try_with(|s| {
+            if let Ok(mut spare) = s.try_borrow_mut() {
+                if spare.len() < SPARE_STORAGES {
+                    spare.push(storage);
+                }
+            }
+        });
+    }
 }
 
 /// `v` emptied, then `n` copies of `x`: what `vec![x; n]` holds.
