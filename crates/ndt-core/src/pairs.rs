@@ -86,12 +86,19 @@ impl Storage {
         spare.ok().flatten().unwrap_or_default()
     }
 
-    /// Emptied, then `n` chunks of each, as new vectors hold them.
-    fn filled(mut self, n: usize) -> Self {
-        fill(&mut self.chunks, n, Chunk::default());
-        fill(&mut self.keys, n, KeyLanes::default());
+    /// `n` chunks of each. The chunks' and keys' columns keep what a
+    /// previous use left: each is written before it is read, so the
+    /// results are those of new vectors. [`ScanPairs::set_points`] writes
+    /// every point and clears the padding lanes' pairs; with nothing known
+    /// (emptied here, and again at the first evaluation) every point's
+    /// lane has its pair and kept key written; `cell_keys` writes `fresh`,
+    /// `valid` and `same`. Zeroing the chunks instead took 4.7 % of the
+    /// loop's instructions (BENCHMARK.md, "Speed", session 27).
+    fn sized(mut self, n: usize) -> Self {
+        resize(&mut self.chunks, n, Chunk::default());
+        resize(&mut self.keys, n, KeyLanes::default());
+        resize(&mut self.fresh, n, KeyLanes::default());
         fill(&mut self.known, n, Known::default());
-        fill(&mut self.fresh, n, KeyLanes::default());
         fill(&mut self.valid, n, 0);
         fill(&mut self.same, n, 0);
         self
@@ -134,6 +141,12 @@ fn fill<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
     v.resize(n, x);
 }
 
+/// `v`'s first `n` as they are, then copies of `x` up to `n`.
+fn resize<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
+    v.truncate(n);
+    v.resize(n, x);
+}
+
 impl<'a> ScanPairs<'a> {
     /// `points` (scan frame \[m\]), each standing for `weights[i]` points (1
     /// without weights), with nothing paired yet.
@@ -143,9 +156,8 @@ impl<'a> ScanPairs<'a> {
             points,
             weights,
             source: None,
-            store: Storage::spare().filled(n),
+            store: Storage::spare().sized(n),
         };
-        // Fresh chunks hold zeros, pairs included: only the points are set.
         pairs.set_points(points, weights);
         pairs
     }
@@ -161,8 +173,9 @@ impl<'a> ScanPairs<'a> {
         }
     }
 
-    /// The points of the chunks (padding lanes at the origin; with no pair
-    /// they add exact zeros), leaving the pairs' columns as they are.
+    /// The points of the chunks (padding lanes at the origin, with no pair:
+    /// they add exact zeros), leaving the points' pairs' columns as they
+    /// are.
     fn set_points(&mut self, points: &'a [[f64; 2]], weights: Option<&'a [f64]>) {
         let n = points.len().div_ceil(LANES).min(self.store.keys.len());
         self.points = points
@@ -173,9 +186,17 @@ impl<'a> ScanPairs<'a> {
         self.store.chunks.truncate(n);
         for (c, ch) in self.store.chunks.iter_mut().enumerate() {
             for l in 0..LANES {
-                let p = self.points.get(c * LANES + l).copied().unwrap_or([0.0; 2]);
-                ch.x[l] = p[0];
-                ch.y[l] = p[1];
+                match self.points.get(c * LANES + l) {
+                    Some(p) => {
+                        ch.x[l] = p[0];
+                        ch.y[l] = p[1];
+                    }
+                    None => {
+                        ch.x[l] = 0.0;
+                        ch.y[l] = 0.0;
+                        ch.clear_pair(l);
+                    }
+                }
             }
         }
     }
@@ -611,15 +632,26 @@ mod tests {
     #[test]
     fn reused_storage_gives_the_bits_of_new_storage() {
         let mut grid = NdtGrid::new(0.02).unwrap();
+        // A wall, and a short one through the origin, where the padding
+        // lanes' points are.
         let wall: Vec<[f64; 2]> = (0..500)
             .map(|i| [f64::from(i) * 0.004, 0.5 + 0.002 * f64::from(i % 5)])
+            .chain((0..30).map(|i| [f64::from(i) * 0.002 - 0.03, 0.002 * f64::from(i % 3)]))
             .collect();
         grid.insert(&wall, Pose2::identity()).unwrap();
         let options = wide_options();
         let d = grid.distributions(0, options).unwrap();
         let inv = 1.0 / d.cell_size();
+        // Its chunk 5 paired on the short wall: the lanes that are padding
+        // in the small scan's last chunk.
         let big: Vec<[f64; 2]> = (0..333)
-            .map(|i| [f64::from(i) * 0.005, 0.49 + 0.001 * f64::from(i % 3)])
+            .map(|i| {
+                if (40..48).contains(&i) {
+                    [0.002 * f64::from(i - 44), 0.001]
+                } else {
+                    [f64::from(i) * 0.005, 0.49 + 0.001 * f64::from(i % 3)]
+                }
+            })
             .collect();
         let heavy: Vec<f64> = (0..333).map(|i| 2.0 + f64::from(i % 4)).collect();
         // Every third point far from the wall: no pair, so its lane must
