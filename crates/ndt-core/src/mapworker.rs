@@ -57,6 +57,10 @@ const BATCH_LENGTH: usize = 8;
 /// and the copies of scans it holds).
 const QUEUE_LENGTH: usize = 2;
 
+/// Done batches kept for their storage (`Spare`): as many as can be on
+/// their way at once.
+const SPARE_BATCHES: usize = QUEUE_LENGTH + 2;
+
 /// The map's memory bound: the cells of the mapper's last `size` scans (0:
 /// every scan's).
 #[derive(Debug, Clone)]
@@ -89,6 +93,37 @@ impl MapWindow {
     }
 }
 
+/// Batches the helper is done with, emptied, and their scans: the loop
+/// takes the next ones' storage from them. Memory the loop's thread
+/// allocated and the helper's thread freed made both threads wait for
+/// glibc's lock of the loop's arena (BENCHMARK.md, "Speed", session 27).
+struct Spare {
+    batches: Vec<Vec<CheckedScan>>,
+    scans: Vec<CheckedScan>,
+}
+
+impl Spare {
+    /// Room for what `SPARE_BATCHES` batches hold, reserved now: keeping
+    /// never grows these vectors.
+    fn new() -> Self {
+        Self {
+            batches: Vec::with_capacity(SPARE_BATCHES),
+            scans: Vec::with_capacity(SPARE_BATCHES * BATCH_LENGTH),
+        }
+    }
+
+    /// Keeps a done batch's storage, up to the bounds (the rest is freed).
+    fn keep(&mut self, mut batch: Vec<CheckedScan>) {
+        let room = self.scans.capacity() - self.scans.len();
+        let n = batch.len().min(room);
+        self.scans.extend(batch.drain(..n));
+        batch.clear();
+        if self.batches.len() < self.batches.capacity() {
+            self.batches.push(batch);
+        }
+    }
+}
+
 /// What the loop and the helper share.
 struct Shared {
     /// Written by the helper only; read by views, which exist only while the
@@ -97,6 +132,7 @@ struct Shared {
     mapper: RwLock<Mapper>,
     /// Used by whoever holds `mapper` for writing.
     window: Mutex<MapWindow>,
+    spare: Mutex<Spare>,
     state: Mutex<Progress>,
     idle: Condvar,
 }
@@ -134,8 +170,8 @@ fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
 
 /// A checked scan into `mapper`, then the cells `window` drops after it:
 /// what a job does, and what the loop does in line.
-fn apply_scan(mapper: &mut Mapper, window: &mut MapWindow, scan: CheckedScan) -> Result<()> {
-    let stale = window.record(&scan, 1.0 / mapper.grid().cell_size());
+fn apply_scan(mapper: &mut Mapper, window: &mut MapWindow, scan: &CheckedScan) -> Result<()> {
+    let stale = window.record(scan, 1.0 / mapper.grid().cell_size());
     let mut mapper = mapper.batch();
     mapper.insert_checked(scan)?;
     mapper.remove_cells(&stale);
@@ -143,7 +179,7 @@ fn apply_scan(mapper: &mut Mapper, window: &mut MapWindow, scan: CheckedScan) ->
 }
 
 /// Runs a batch of scans in order (the first error is kept, the other scans
-/// still run).
+/// still run), then keeps its storage for the loop.
 fn serve_batch(shared: &Shared, batch: Vec<CheckedScan>) {
     let mut done = Done {
         shared,
@@ -154,7 +190,7 @@ fn serve_batch(shared: &Shared, batch: Vec<CheckedScan>) {
     // The batch's scans bring the coarser levels up to date once, at its
     // end (NdtGrid::deferral, crate/src/grid/deferral.rs): the same map, bit for bit.
     let mut mapper = guard.batch();
-    for scan in batch {
+    for scan in &batch {
         let result = apply_scan(&mut mapper, &mut window, scan);
         if done.result.is_ok() {
             done.result = result;
@@ -164,6 +200,7 @@ fn serve_batch(shared: &Shared, batch: Vec<CheckedScan>) {
     drop(mapper);
     drop(window);
     drop(guard);
+    lock(&shared.spare).keep(batch);
 }
 
 /// The helper thread: runs the batches in order until the loop hangs up.
@@ -180,6 +217,9 @@ pub(crate) struct Behind {
     checker: Mapper,
     /// Scans not yet handed over.
     batch: Mutex<Vec<CheckedScan>>,
+    /// Spare scans taken from `Shared::spare` at once, for the loop's
+    /// checks.
+    scans: Mutex<Vec<CheckedScan>>,
     batches: Option<SyncSender<Vec<CheckedScan>>>,
     thread: Option<JoinHandle<()>>,
     /// The process the helper runs in (a forked child has no helper).
@@ -198,6 +238,7 @@ impl Behind {
         let shared = Arc::new(Shared {
             mapper: RwLock::new(mapper),
             window: Mutex::new(window),
+            spare: Mutex::new(Spare::new()),
             state: Mutex::new(Progress::default()),
             idle: Condvar::new(),
         });
@@ -215,6 +256,7 @@ impl Behind {
             shared,
             checker,
             batch: Mutex::new(Vec::with_capacity(BATCH_LENGTH)),
+            scans: Mutex::new(Vec::with_capacity(SPARE_BATCHES * BATCH_LENGTH)),
             batches: thread.is_some().then_some(tx),
             thread,
             pid: std::process::id(),
@@ -229,12 +271,27 @@ impl Behind {
             .filter(|_| std::process::id() == self.pid)
     }
 
-    /// Adds `scan` to the batch, handing it over when full.
+    /// A spare scan for the next check: one of those the helper is done
+    /// with, if any.
+    fn spare_scan(&self) -> Option<CheckedScan> {
+        let mut scans = lock(&self.scans);
+        if scans.is_empty() {
+            let mut spare = lock(&self.shared.spare);
+            let n = spare.scans.len().min(scans.capacity());
+            scans.extend(spare.scans.drain(..n));
+        }
+        scans.pop()
+    }
+
+    /// Adds `scan` to the batch, handing it over when full (the next batch
+    /// in a done one's storage).
     fn submit(&mut self, scan: CheckedScan) {
         let batch = self.batch.get_mut().unwrap_or_else(|e| e.into_inner());
         batch.push(scan);
         if batch.len() >= BATCH_LENGTH {
-            let full = std::mem::replace(batch, Vec::with_capacity(BATCH_LENGTH));
+            let next = lock(&self.shared.spare).batches.pop();
+            let next = next.unwrap_or_else(|| Vec::with_capacity(BATCH_LENGTH));
+            let full = std::mem::replace(batch, next);
             self.hand_over(full);
         }
     }
@@ -356,9 +413,12 @@ impl MapperHost {
         pose: Pose2,
     ) -> Result<CheckedScan> {
         match self {
-            Self::Inline(m, _) => m.check_scan(ranges, angles, directions, pose),
+            Self::Inline(m, _) => m.check_scan(ranges, angles, directions, pose, None),
             Self::Behind(b) => {
-                let scan = b.checker.check_scan(ranges, angles, directions, pose)?;
+                let spare = b.spare_scan();
+                let scan = b
+                    .checker
+                    .check_scan(ranges, angles, directions, pose, spare)?;
                 b.take_error().map_or(Ok(scan), Err)
             }
         }
@@ -369,7 +429,7 @@ impl MapperHost {
     /// now, or queued as one job.
     pub(crate) fn update(&mut self, scan: CheckedScan) -> Result<()> {
         match self {
-            Self::Inline(m, window) => apply_scan(m, window, scan),
+            Self::Inline(m, window) => apply_scan(m, window, &scan),
             Self::Behind(b) => {
                 b.submit(scan);
                 Ok(())
@@ -515,7 +575,9 @@ mod tests {
             };
             let points = directions.points(&ranges, &angles, lo, hi).unwrap();
             let kept = (trial % 2 == 0).then(|| directions.directions());
-            let scan = mapper.check_scan(&ranges, &angles, kept, pose).unwrap();
+            let scan = mapper
+                .check_scan(&ranges, &angles, kept, pose, None)
+                .unwrap();
             let mut grid = NdtGrid::new(cell).unwrap();
             let staged = grid.insert(&points, pose).unwrap();
             assert!(!staged.is_empty() || points.is_empty());
@@ -564,5 +626,52 @@ mod tests {
         );
         assert_eq!(taken(&batched), taken(&each));
         assert_eq!(format!("{batched:?}").split('(').next(), Some("Batches"));
+    }
+
+    /// The helper gives a done batch's scans and vector back, and the
+    /// loop's next checks and batch take them; what is kept never grows.
+    #[test]
+    fn done_batches_come_back_to_the_loop() {
+        let mapper = Mapper::new(0.02, MapperOptions::default()).unwrap();
+        let mut host = MapperHost::new(mapper, Hosting::Helper, 4).unwrap();
+        let (r, a) = wall();
+        let pools = |host: &MapperHost| match host {
+            MapperHost::Behind(b) => {
+                let spare = b.shared.spare.lock().unwrap();
+                let stash = b.scans.lock().unwrap();
+                [
+                    spare.scans.len(),
+                    spare.batches.len(),
+                    stash.len(),
+                    spare.scans.capacity(),
+                    spare.batches.capacity(),
+                    stash.capacity(),
+                ]
+            }
+            MapperHost::Inline(..) => [usize::MAX; 6],
+        };
+        let room = [SPARE_BATCHES * BATCH_LENGTH, SPARE_BATCHES];
+        for k in 0..BATCH_LENGTH {
+            let pose = Pose2::new(0.01 * k as f64, 0.0, 0.0);
+            let scan = host.check_scan(&r, &a, None, pose).unwrap();
+            host.update(scan).unwrap();
+        }
+        host.settle();
+        assert_eq!(pools(&host), [8, 1, 0, room[0], room[1], room[0]]);
+        let scan = host.check_scan(&r, &a, None, Pose2::identity()).unwrap();
+        assert_eq!(pools(&host), [0, 1, 7, room[0], room[1], room[0]]);
+        host.update(scan).unwrap();
+        for k in 0..20 * BATCH_LENGTH {
+            let pose = Pose2::new(0.001 * k as f64, 0.0, 0.0);
+            let scan = host.check_scan(&r, &a, None, pose).unwrap();
+            host.update(scan).unwrap();
+        }
+        host.settle();
+        let [scans, batches, stash, cap_scans, cap_batches, cap_stash] = pools(&host);
+        assert!(scans + stash <= room[0] && batches <= room[1]);
+        assert_eq!(
+            [cap_scans, cap_batches, cap_stash],
+            [room[0], room[1], room[0]]
+        );
     }
 }

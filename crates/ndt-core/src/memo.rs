@@ -17,11 +17,26 @@ use crate::se2::Pose2;
 /// the last one evaluated: rejected line-search trials come after it).
 const CAPACITY: usize = 8;
 
-/// The last few (8) evaluations of whole-scan score terms, by level.
-#[derive(Debug, Default)]
+/// One evaluation: level, pose, order and terms.
+type Entry = (usize, Pose2, Order, PassTerms);
+
+/// The last few (8) evaluations of whole-scan score terms, by level, held
+/// in place (a vector of them, grown in each match, took the allocator's
+/// lock: BENCHMARK.md, "Speed", session 27).
+#[derive(Debug)]
 pub struct LevelMemo {
-    entries: Vec<(usize, Pose2, Order, PassTerms)>,
+    /// Filled in order, then each next one replaces the oldest.
+    entries: [Option<Entry>; CAPACITY],
     next: usize,
+}
+
+impl Default for LevelMemo {
+    fn default() -> Self {
+        Self {
+            entries: [None; CAPACITY],
+            next: 0,
+        }
+    }
 }
 
 impl LevelMemo {
@@ -30,6 +45,7 @@ impl LevelMemo {
     pub fn get(&self, level: usize, pose: Pose2, order: Order) -> Option<PassTerms> {
         self.entries
             .iter()
+            .flatten()
             .find(|(l, p, o, _)| {
                 *l == level && *p == pose && (*o == order || *o == Order::Derivatives)
             })
@@ -47,13 +63,10 @@ impl LevelMemo {
 
     /// Records the terms of `level` at `pose`.
     pub fn put(&mut self, level: usize, pose: Pose2, order: Order, terms: PassTerms) {
-        let entry = (level, pose, order, terms);
-        if self.entries.len() < CAPACITY {
-            self.entries.push(entry);
-        } else {
-            self.entries[self.next] = entry;
-            self.next = (self.next + 1) % CAPACITY;
+        if let Some(e) = self.entries.get_mut(self.next) {
+            *e = Some((level, pose, order, terms));
         }
+        self.next = (self.next + 1) % CAPACITY;
     }
 }
 

@@ -757,6 +757,8 @@ impl Odometry {
         if odom.is_some() {
             self.last_odom = odom;
         }
+        let num_points = points.len();
+        self.beams.give_back(points);
         Ok(StepOutcome {
             pose,
             prediction,
@@ -764,7 +766,7 @@ impl Odometry {
             accepted,
             multi_start,
             inserted,
-            num_points: points.len(),
+            num_points,
         })
     }
 
@@ -777,7 +779,9 @@ impl Odometry {
         let points = self.valid_points(ranges, angles)?;
         let into_grid = !self.config.match_filtered_map;
         let to_map = self.config.build_map;
-        self.insert_points(&points, ranges, angles, pose, to_map, into_grid)
+        let done = self.insert_points(&points, ranges, angles, pose, to_map, into_grid);
+        self.beams.give_back(points);
+        done
     }
 
     /// [`Odometry::update_map`] with the scan's valid points already taken

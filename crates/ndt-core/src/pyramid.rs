@@ -237,7 +237,7 @@ impl Pyramid {
     /// [`Pyramid::add_fine`]). Returns the fine cells actually removed.
     pub(crate) fn remove_fine(&mut self, keys: &[CellKey]) -> Vec<CellKey> {
         let seen = self.seen.take();
-        let mut removed = Vec::new();
+        let mut removed = Vec::with_capacity(keys.len());
         for &key in keys {
             if seen.insert(key) && self.levels[0].cells.remove(key).is_some() {
                 removed.push(key);

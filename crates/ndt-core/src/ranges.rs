@@ -28,6 +28,7 @@ pub fn points_from_ranges(
 ) -> Result<Vec<[f64; 2]>> {
     check_scan_and_limits(ranges, angles, min_range, max_range)?;
     Ok(points_along(
+        Vec::new(),
         ranges,
         angles.iter().map(|a| a.sin_cos()),
         min_range,
@@ -60,8 +61,10 @@ fn check_scan_and_limits(
     Ok(())
 }
 
-/// The points of the valid ranges along the beams' `(sin a, cos a)`.
+/// The points of the valid ranges along the beams' `(sin a, cos a)`, in
+/// `points`' storage.
 fn points_along(
+    mut points: Vec<[f64; 2]>,
     ranges: &[f64],
     directions: impl Iterator<Item = (f64, f64)>,
     min_range: f64,
@@ -70,7 +73,8 @@ fn points_along(
     // Room for every beam at once: collecting a filter grows the vector
     // from a few points by doubling (6 reallocations for 180 beams, 0.5 % of
     // the odometry loop's instructions, BENCHMARK.md "Speed", session 20).
-    let mut points = Vec::with_capacity(ranges.len());
+    points.clear();
+    points.reserve(ranges.len());
     points.extend(
         ranges
             .iter()
@@ -89,6 +93,11 @@ fn points_along(
 pub struct BeamDirections {
     angles: Vec<f64>,
     directions: Vec<(f64, f64)>,
+    /// Points given back ([`BeamDirections::give_back`]): the next
+    /// points' storage. A new vector a scan took the allocator's lock
+    /// twice, which a mapper's helper thread may hold (BENCHMARK.md,
+    /// "Speed", session 27).
+    spare: Vec<[f64; 2]>,
 }
 
 impl BeamDirections {
@@ -114,6 +123,7 @@ impl BeamDirections {
             self.directions.extend(angles.iter().map(|a| a.sin_cos()));
         }
         Ok(points_along(
+            std::mem::take(&mut self.spare),
             ranges,
             self.directions.iter().copied(),
             min_range,
@@ -126,6 +136,12 @@ impl BeamDirections {
     pub fn directions(&self) -> &[(f64, f64)] {
         &self.directions
     }
+
+    /// Points of [`BeamDirections::points`] done with: the next call gives
+    /// its points in their storage.
+    pub fn give_back(&mut self, points: Vec<[f64; 2]>) {
+        self.spare = points;
+    }
 }
 
 #[cfg(test)]
@@ -133,8 +149,9 @@ mod tests {
     use super::*;
 
     /// The kept directions give `points_from_ranges`'s points bit for bit,
-    /// when the angles repeat and when they change (length or value), and
-    /// the same errors.
+    /// when the angles repeat and when they change (length or value), in
+    /// the storage of the points given back (longer or shorter), and the
+    /// same errors.
     #[test]
     fn kept_directions_give_the_same_points() {
         let mut kept = BeamDirections::default();
@@ -160,6 +177,7 @@ mod tests {
                     .collect()
             };
             assert_eq!(bits(&got), bits(&want), "scan {k}");
+            kept.give_back(got);
         }
         let short = [1.0, 2.0];
         assert_eq!(

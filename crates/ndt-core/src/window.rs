@@ -33,16 +33,25 @@ impl CellWindow {
             self.stamps.insert(key, n);
         }
         self.history.push_back((n, touched));
+        // The stale cells are kept in the leaving scan's own vector (no
+        // vector grows: on a helper thread, growing one could wait for the
+        // allocator's lock, BENCHMARK.md, "Speed", session 27).
         let mut stale = Vec::new();
         while self.history.len() > size {
-            let Some((m, keys)) = self.history.pop_front() else {
+            let Some((m, mut keys)) = self.history.pop_front() else {
                 break;
             };
-            for key in keys {
-                if self.stamps.get(&key) == Some(&m) {
-                    self.stamps.remove(&key);
-                    stale.push(key);
+            keys.retain(|key| {
+                let last = self.stamps.get(key) == Some(&m);
+                if last {
+                    self.stamps.remove(key);
                 }
+                last
+            });
+            if stale.is_empty() {
+                stale = keys;
+            } else {
+                stale.extend_from_slice(&keys);
             }
         }
         stale

@@ -180,21 +180,22 @@ impl Mapper {
     }
 
     /// The checks of [`Mapper::insert_scan`], changing nothing (see
-    /// [`MapFilter::check_scan`]).
+    /// [`MapFilter::check_scan`]; `spare`'s storage reused).
     pub(crate) fn check_scan(
         &self,
         ranges: &[f64],
         angles: &[f64],
         directions: Option<&[(f64, f64)]>,
         pose: Pose2,
+        spare: Option<CheckedScan>,
     ) -> Result<CheckedScan> {
         self.filter
-            .check_scan(&self.grid, ranges, angles, directions, pose)
+            .check_scan(&self.grid, ranges, angles, directions, pose, spare)
     }
 
     /// Adds a scan [`Mapper::check_scan`] passed, on this mapper or on one
     /// with the same options and cell size (see [`MapFilter::insert_checked`]).
-    pub(crate) fn insert_checked(&mut self, checked: CheckedScan) -> Result<()> {
+    pub(crate) fn insert_checked(&mut self, checked: &CheckedScan) -> Result<()> {
         self.filter.insert_checked(&mut self.grid, checked)
     }
 

@@ -68,8 +68,8 @@ impl MapFilter {
         angles: &[f64],
         pose: Pose2,
     ) -> Result<()> {
-        let scan = self.check_scan(grid, ranges, angles, None, pose)?;
-        self.insert_checked(grid, scan)
+        let scan = self.check_scan(grid, ranges, angles, None, pose, None)?;
+        self.insert_checked(grid, &scan)
     }
 
     /// [`MapFilter::insert_scan`] of a scan [`MapFilter::check_scan`] passed
@@ -77,9 +77,9 @@ impl MapFilter {
     pub(crate) fn insert_checked(
         &mut self,
         grid: &mut NdtGrid,
-        checked: CheckedScan,
+        checked: &CheckedScan,
     ) -> Result<()> {
-        let CheckedScan { beams, pose } = checked;
+        let (beams, pose) = (checked.beams.as_slice(), checked.pose);
         // The insert and the deletions below (and a periodic check's) bring
         // the coarser levels up to date once (NdtGrid::deferral, crate/src/grid/deferral.rs).
         let mut deferred = grid.deferral();
@@ -108,7 +108,7 @@ impl MapFilter {
         let mut small = vec![false; n];
         let mut dropped: Vec<(usize, Dropped)> = Vec::new();
         // §V step a-1: cluster the scan, select the small clusters.
-        let groups = clusters(&beams, o.cluster_gap, o.cluster_spacing_factor);
+        let groups = clusters(beams, o.cluster_gap, o.cluster_spacing_factor);
         for g in &groups {
             let cluster = &beams[g.clone()];
             if !is_small(cluster, o.small_object_size) {
@@ -159,10 +159,15 @@ impl MapFilter {
                 }
             }
         }
-        let hit: Vec<CellKey> = (0..n)
-            .filter(|&i| keep[i])
-            .filter_map(|i| CellKey::of(beams[i].world, inv_cell))
-            .collect();
+        // Vectors sized at once (here and below): each growth of a vector
+        // would take the allocator's lock (BENCHMARK.md, "Speed", session
+        // 27).
+        let mut hit: Vec<CellKey> = Vec::with_capacity(n);
+        hit.extend(
+            (0..n)
+                .filter(|&i| keep[i])
+                .filter_map(|i| CellKey::of(beams[i].world, inv_cell)),
+        );
         let hit_set: FxHashSet<CellKey> = hit.iter().copied().collect();
         // §V step d: cells short of a kept hit are free space (decided
         // against the map as it was before this scan).
@@ -205,10 +210,12 @@ impl MapFilter {
             .copied()
             .collect();
         // Commit: the only fallible call comes first.
-        let points: Vec<[f64; 2]> = (0..n)
-            .filter(|&i| keep[i])
-            .map(|i| [beams[i].local.x, beams[i].local.y])
-            .collect();
+        let mut points: Vec<[f64; 2]> = Vec::with_capacity(n);
+        points.extend(
+            (0..n)
+                .filter(|&i| keep[i])
+                .map(|i| [beams[i].local.x, beams[i].local.y]),
+        );
         grid.insert(&points, pose)?;
         let kept = (0..n).filter(|&i| keep[i]);
         for (i, key) in kept.zip(hit) {
@@ -224,7 +231,7 @@ impl MapFilter {
         }
         let removed = self.delete(grid, &clear);
         self.counts.confirmation_cells += removed as u64;
-        self.count_dropped(grid, &beams, &dropped, inv_cell);
+        self.count_dropped(grid, beams, &dropped, inv_cell);
         self.scans = scan;
         if check_due(scan, o.check_interval) {
             self.run_checks(grid);
@@ -238,7 +245,8 @@ impl MapFilter {
     /// failures are the grid's checks of the same points). They depend on
     /// the options and the grid's cell size alone. `directions`: the beams'
     /// `(sin a, cos a)`, when the caller keeps them (one per angle; else
-    /// computed here).
+    /// computed here). `spare`: a checked scan done with, whose storage
+    /// the new one takes.
     pub(crate) fn check_scan(
         &self,
         grid: &NdtGrid,
@@ -246,13 +254,17 @@ impl MapFilter {
         angles: &[f64],
         directions: Option<&[(f64, f64)]>,
         pose: Pose2,
+        spare: Option<CheckedScan>,
     ) -> Result<CheckedScan> {
-        let beams = self.valid_beams(grid, ranges, angles, directions, pose)?;
+        let mut beams = spare.map(|s| s.beams).unwrap_or_default();
+        beams.clear();
+        self.valid_beams(grid, ranges, angles, directions, pose, &mut beams)?;
         Ok(CheckedScan { beams, pose })
     }
 
-    /// The valid beams of a scan, checked: lengths, finite angles and pose,
-    /// cell indices in range (see [`MapFilter::check_scan`]).
+    /// The valid beams of a scan, checked (lengths, finite angles and pose,
+    /// cell indices in range, see [`MapFilter::check_scan`]), added to
+    /// `beams`.
     fn valid_beams(
         &self,
         grid: &NdtGrid,
@@ -260,12 +272,13 @@ impl MapFilter {
         angles: &[f64],
         directions: Option<&[(f64, f64)]>,
         pose: Pose2,
-    ) -> Result<Vec<Beam>> {
+        beams: &mut Vec<Beam>,
+    ) -> Result<()> {
         check_beams(ranges, angles)?;
         check_finite("pose", &pose.to_array())?;
         let (lo, hi) = (self.options.min_range, self.options.max_range);
         let inv_cell = 1.0 / grid.cell_size();
-        let mut beams = Vec::with_capacity(ranges.len());
+        beams.reserve(ranges.len());
         let sin_cos = pose.theta.sin_cos();
         for (index, (&r, &a)) in ranges.iter().zip(angles).enumerate() {
             if !(r.is_finite() && r > 0.0 && r >= lo && r < hi) {
@@ -286,7 +299,7 @@ impl MapFilter {
             }
             beams.push(beam);
         }
-        Ok(beams)
+        Ok(())
     }
 
     /// Adds the dropped points, and the distinct cells they would have
