@@ -52,7 +52,7 @@ pub struct CellRecord {
 
 /// A scan checked by [`NdtGrid::stage`]: its points in map coordinates
 /// with their finest-level cells.
-#[derive(Debug)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct StagedScan {
     points: Vec<(CellKey, Vector2<f64>)>,
 }
@@ -215,14 +215,24 @@ impl NdtGrid {
     ///
     /// Returns the keys of the cells that changed (each once, first-touch order).
     pub fn insert(&mut self, points: &[[f64; 2]], pose: Pose2) -> Result<Vec<CellKey>> {
-        let staged = self.stage(points, pose)?;
-        Ok(self.insert_staged(staged))
+        let staged = self.stage(points, pose, StagedScan::default())?;
+        Ok(self.insert_staged(&staged))
     }
 
     /// The checks of [`NdtGrid::insert`], without touching the grid: the
     /// points in map coordinates with their cells, ready for
     /// [`NdtGrid::insert_staged`] (which then cannot fail).
-    pub(crate) fn stage(&self, points: &[[f64; 2]], pose: Pose2) -> Result<StagedScan> {
+    ///
+    /// The staged points take `spare`'s storage: the odometry loop stages
+    /// every scan its matching grid takes, and a new vector each time took
+    /// the allocator's lock, which the mapper's helper thread may hold
+    /// (BENCHMARK.md, "Speed", session 27).
+    pub(crate) fn stage(
+        &self,
+        points: &[[f64; 2]],
+        pose: Pose2,
+        spare: StagedScan,
+    ) -> Result<StagedScan> {
         check_finite("pose", &pose.to_array())?;
         check_points("points", points)?;
         let sin_cos = pose.theta.sin_cos();
@@ -231,15 +241,14 @@ impl NdtGrid {
         // every cell exists is checked once at the end, and only a scan that
         // fails is searched for its first point beyond the lattice.
         let mut all = true;
-        let staged: Vec<(CellKey, Vector2<f64>)> = points
-            .iter()
-            .map(|p| {
-                let w = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
-                let (key, ok) = CellKey::of_flagged(w, inv);
-                all &= ok;
-                (key, w)
-            })
-            .collect();
+        let mut staged = spare.points;
+        staged.clear();
+        staged.extend(points.iter().map(|p| {
+            let w = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
+            let (key, ok) = CellKey::of_flagged(w, inv);
+            all &= ok;
+            (key, w)
+        }));
         if all {
             return Ok(StagedScan { points: staged });
         }
@@ -262,15 +271,17 @@ impl NdtGrid {
     /// Adds a scan staged by [`NdtGrid::stage`] on this grid: eq. (6) into
     /// every pyramid level, then the prepared distributions of the touched
     /// cells. Returns the touched finest-level keys (see [`NdtGrid::insert`]).
-    pub(crate) fn insert_staged(&mut self, staged: StagedScan) -> Vec<CellKey> {
+    pub(crate) fn insert_staged(&mut self, staged: &StagedScan) -> Vec<CellKey> {
         if self.deferring > 0 {
             let fine = self.pyramid.add_fine(&staged.points);
             self.pending.extend_from_slice(&fine);
             return fine;
         }
-        let touched = self.pyramid.add(&staged.points);
+        let mut touched = self.pyramid.add(&staged.points);
         self.update_prepared(&touched);
-        touched.into_iter().next().unwrap_or_default()
+        let fine = touched.first_mut().map(std::mem::take).unwrap_or_default();
+        self.pyramid.give_back(touched);
+        fine
     }
 
     /// Removes the cells `keys` (their eq. (6) sums entirely) from the grid,
@@ -286,17 +297,25 @@ impl NdtGrid {
         if self.deferring > 0 {
             let removed = self.pyramid.remove_fine(keys);
             self.pending.extend_from_slice(&removed);
-            self.removals.add(removed.len());
-            return removed.len();
+            let n = removed.len();
+            self.removals.add(n);
+            self.pyramid.give_back([removed]);
+            return n;
         }
         let touched = self.pyramid.remove(keys);
         let removed = touched.first().map_or(0, Vec::len);
-        if removed == 0 {
-            return 0;
+        if removed > 0 {
+            self.removals.add(removed);
+            self.update_prepared(&touched);
         }
-        self.removals.add(removed);
-        self.update_prepared(&touched);
+        self.pyramid.give_back(touched);
         removed
+    }
+
+    /// Keys done with (e.g. those [`NdtGrid::insert`] returned, once used):
+    /// the grid's next updates keep their results in that storage.
+    pub(crate) fn give_back(&mut self, keys: Vec<CellKey>) {
+        self.pyramid.give_back([keys]);
     }
 
     /// Brings the prepared distributions up to date after the pyramid

@@ -175,6 +175,7 @@ fn apply_scan(mapper: &mut Mapper, window: &mut MapWindow, scan: &CheckedScan) -
     let mut mapper = mapper.batch();
     mapper.insert_checked(scan)?;
     mapper.remove_cells(&stale);
+    mapper.give_back(stale);
     Ok(())
 }
 

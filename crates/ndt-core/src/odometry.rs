@@ -20,7 +20,7 @@
 use std::collections::VecDeque;
 
 use crate::error::{check_bound, check_finite, NdtError, Result};
-use crate::grid::NdtGrid;
+use crate::grid::{NdtGrid, StagedScan};
 use crate::mapper::{Mapper, MapperOptions};
 use crate::mapworker::{Hosting, MapperHost, MapperView};
 use crate::matcher::{levels_up_to, MatchOptions, MatchResult};
@@ -429,6 +429,8 @@ pub struct Odometry {
     scores: VecDeque<f64>,
     /// The beams' directions, kept from scan to scan.
     beams: BeamDirections,
+    /// The last scan staged for the matching grid: the next one's storage.
+    staged: StagedScan,
 }
 
 impl Odometry {
@@ -462,6 +464,7 @@ impl Odometry {
             grid_window: CellWindow::default(),
             scores: VecDeque::with_capacity(GATE_HISTORY + 1),
             beams: BeamDirections::default(),
+            staged: StagedScan::default(),
         })
     }
 
@@ -817,10 +820,14 @@ impl Odometry {
         if into_grid {
             // The scan's cells, checked before the grid changes (the mapper
             // checked the same points on the same lattice above).
-            let staged = self.grid.stage(points, pose)?;
-            let keys = self.grid.insert_staged(staged);
+            let staged = self
+                .grid
+                .stage(points, pose, std::mem::take(&mut self.staged))?;
+            let keys = self.grid.insert_staged(&staged);
+            self.staged = staged;
             let stale = self.grid_window.record(keys, self.config.match_map_window);
             self.grid.remove_cells(&stale);
+            self.grid.give_back(stale);
             self.last_grid_insert = Some(pose);
         }
         let Some(checked) = checked else {

@@ -15,6 +15,9 @@ use crate::table::CellTable;
 /// Most levels a grid may have (fine level included).
 pub const MAX_LEVELS: usize = 12;
 
+/// Key vectors a pyramid keeps for its next updates ([`Pyramid::give_back`]).
+const SPARE_KEYS: usize = 2 * MAX_LEVELS;
+
 /// One level of the pyramid: cells of `cell_size` metres with their sums
 /// about each cell's centre, in dense tiles ([`CellTable`]): a coarse cell's
 /// 4 children always share a tile of the level below, and a scan's cells
@@ -49,6 +52,11 @@ pub struct Pyramid {
     occupied: Occupancy,
     /// The keys an update has met (reused between updates).
     seen: KeyScratch,
+    /// Emptied key vectors given back, the storage of the next updates'
+    /// results: the odometry loop updates its matching grid every few
+    /// scans, and each new vector took the allocator's lock, which the
+    /// mapper's helper thread may hold (BENCHMARK.md, "Speed", session 27).
+    spare: Vec<Vec<CellKey>>,
 }
 
 /// The key of the level-`level` cell covering fine cell `key`: an arithmetic
@@ -75,7 +83,29 @@ impl Pyramid {
             bounds: None,
             occupied: Occupancy::default(),
             seen: KeyScratch::default(),
+            spare: Vec::with_capacity(SPARE_KEYS),
         }
+    }
+
+    /// Key vectors done with (an update's results): the next updates' results
+    /// take their storage. Those beyond the spares kept are freed.
+    pub fn give_back(&mut self, keys: impl IntoIterator<Item = Vec<CellKey>>) {
+        for mut k in keys {
+            if self.spare.len() >= SPARE_KEYS {
+                break;
+            }
+            if k.capacity() > 0 {
+                k.clear();
+                self.spare.push(k);
+            }
+        }
+    }
+
+    /// An empty key vector with room for `n` keys (a spare's storage).
+    fn keys(&mut self, n: usize) -> Vec<CellKey> {
+        let mut v = self.spare.pop().unwrap_or_default();
+        v.reserve(n);
+        v
     }
 
     /// A rectangle of fine keys holding every occupied fine cell (possibly
@@ -131,9 +161,9 @@ impl Pyramid {
     /// `staged`, the occupancy and the bounds; the coarser levels are left
     /// for [`Pyramid::refresh`]. Returns the fine cells that changed.
     pub(crate) fn add_fine(&mut self, staged: &[(CellKey, Vector2<f64>)]) -> Vec<CellKey> {
+        let mut touched = self.keys(staged.len());
         let fine = &mut self.levels[0];
         let seen = self.seen.take();
-        let mut touched = Vec::with_capacity(staged.len());
         let mut run: Option<(CellKey, CellStats)> = None;
         let mut flush = |key: CellKey, stats: &CellStats| {
             fine.cells.get_or_default(key).merge(stats);
@@ -176,8 +206,9 @@ impl Pyramid {
     /// (a coarse cell is a function of the fine cells alone). Returns the
     /// changed keys per level (level 0: `fine`, each once).
     pub(crate) fn refresh(&mut self, fine: &[CellKey]) -> Vec<Vec<CellKey>> {
+        let mut once = self.keys(fine.len());
         let seen = self.seen.take();
-        let once: Vec<CellKey> = fine.iter().copied().filter(|&k| seen.insert(k)).collect();
+        once.extend(fine.iter().copied().filter(|&k| seen.insert(k)));
         self.refresh_parents(once)
     }
 
@@ -189,8 +220,8 @@ impl Pyramid {
         touched_all.push(fine);
         for l in 1..self.levels.len() {
             let below = touched_all[l - 1].len();
+            let mut changed = self.keys(below);
             let parents = self.seen.take();
-            let mut changed = Vec::with_capacity(below);
             // Changed children come in runs under one parent: the last
             // parent is not looked up again.
             let mut last = None;
@@ -236,8 +267,8 @@ impl Pyramid {
     /// The fine level's part of [`Pyramid::remove`] (see
     /// [`Pyramid::add_fine`]). Returns the fine cells actually removed.
     pub(crate) fn remove_fine(&mut self, keys: &[CellKey]) -> Vec<CellKey> {
+        let mut removed = self.keys(keys.len());
         let seen = self.seen.take();
-        let mut removed = Vec::with_capacity(keys.len());
         for &key in keys {
             if seen.insert(key) && self.levels[0].cells.remove(key).is_some() {
                 removed.push(key);
@@ -262,5 +293,56 @@ impl Pyramid {
             level.cells.clear();
         }
         self.refresh_parents(states.iter().map(|(k, _)| *k).collect());
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    /// A pyramid given its results back returns the keys and holds the
+    /// sums of one given nothing back, in the storage it was given (last
+    /// given, first used); it keeps at most `SPARE_KEYS` vectors.
+    #[test]
+    fn given_back_storage_changes_no_result() {
+        let mut rng = StdRng::seed_from_u64(3);
+        let (mut reused, mut fresh) = (Pyramid::new(0.02, 4), Pyramid::new(0.02, 4));
+        for round in 0..60 {
+            let staged: Vec<(CellKey, Vector2<f64>)> = (0..rng.random_range(1..300))
+                .map(|_| {
+                    let w = Vector2::new(rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0));
+                    (CellKey::of(w, 50.0).unwrap(), w)
+                })
+                .collect();
+            let removed: Vec<CellKey> = staged
+                .iter()
+                .step_by(3)
+                .map(|(k, _)| CellKey { ix: k.ix + 1, ..*k })
+                .collect();
+            // A large vector given last (with room for it) is the storage
+            // of the next result.
+            reused.spare.truncate(SPARE_KEYS - 1);
+            let big = Vec::with_capacity(5000);
+            let at = big.as_ptr();
+            reused.give_back([big]);
+            let got = reused.add(&staged);
+            assert_eq!(got, fresh.add(&staged), "round {round}");
+            assert_eq!(got[0].as_ptr(), at);
+            reused.give_back(got);
+            let got = reused.remove(&removed);
+            assert_eq!(got, fresh.remove(&removed), "round {round}");
+            reused.give_back(got);
+            assert!(reused.spare.len() <= SPARE_KEYS);
+            assert!(reused.spare.iter().all(Vec::is_empty));
+        }
+        for l in 0..4 {
+            let (a, b) = (reused.level(l).unwrap(), fresh.level(l).unwrap());
+            assert_eq!(a.cells(), b.cells(), "level {l}");
+        }
+        reused.give_back((0..3 * SPARE_KEYS).map(|_| vec![CellKey { ix: 0, iy: 0 }]));
+        assert_eq!(reused.spare.len(), SPARE_KEYS);
     }
 }

@@ -246,6 +246,12 @@ impl Mapper {
         n
     }
 
+    /// Keys done with: the grid's next updates keep their results in that
+    /// storage (see [`NdtGrid::give_back`]).
+    pub(crate) fn give_back(&mut self, keys: Vec<CellKey>) {
+        self.grid.give_back(keys);
+    }
+
     /// Runs the periodic checks now (see [`MapFilter::run_checks`]).
     pub fn run_checks(&mut self) -> usize {
         self.filter.run_checks(&mut self.grid)
