@@ -97,6 +97,9 @@ impl MapWindow {
 /// takes the next ones' storage from them. Memory the loop's thread
 /// allocated and the helper's thread freed made both threads wait for
 /// glibc's lock of the loop's arena (BENCHMARK.md, "Speed", session 27).
+/// The loop makes a scan only when none is spare, so no more scans exist
+/// than were once on their way at the same time (at most
+/// `SPARE_BATCHES` batches).
 struct Spare {
     batches: Vec<Vec<CheckedScan>>,
     scans: Vec<CheckedScan>,
