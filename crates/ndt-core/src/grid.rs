@@ -76,6 +76,9 @@ pub struct NdtGrid {
     /// Who this grid is and how many fine cells it has lost
     /// ([`NdtGrid::removal_stamp`]).
     removals: removals::Removals,
+    /// The ancestors' shapes of one update of the prepared distributions
+    /// (emptied before each, its storage kept).
+    shapes: ShapeMemo,
 }
 
 impl Clone for NdtGrid {
@@ -98,6 +101,7 @@ impl Clone for NdtGrid {
             deferring: 1,
             // Another grid: its removals are its own from here on.
             removals: removals::Removals::new(),
+            shapes: ShapeMemo::default(),
         };
         copy.end_deferral();
         copy
@@ -136,6 +140,7 @@ impl NdtGrid {
             pending: Vec::new(),
             deferring: 0,
             removals: removals::Removals::new(),
+            shapes: ShapeMemo::default(),
         })
     }
 
@@ -323,18 +328,13 @@ impl NdtGrid {
     /// shape computed once for all the levels that take it.
     fn update_prepared(&mut self, touched: &[Vec<CellKey>]) {
         let prepared = self.prepared.get_mut().unwrap_or_else(|e| e.into_inner());
-        let mut shapes = ShapeMemo::default();
+        let shapes = &mut self.shapes;
+        shapes.clear(PREPARED_CAPACITY);
         for dist in prepared.iter_mut() {
             let l = dist.level();
             if let (Some(level), Some(keys)) = (self.pyramid.level(l), touched.get(l)) {
                 let shape = shape_at(&self.pyramid, l, dist.shape_depth());
-                Arc::make_mut(dist).update(
-                    level.cells(),
-                    level.cell_size(),
-                    keys,
-                    shape,
-                    &mut shapes,
-                );
+                Arc::make_mut(dist).update(level.cells(), level.cell_size(), keys, shape, shapes);
             }
         }
     }

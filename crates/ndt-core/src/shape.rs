@@ -135,6 +135,19 @@ pub struct ShapeReader<'m, 's> {
 }
 
 impl ShapeMemo {
+    /// Forgets every shape, keeping the storage for the next update's
+    /// (each update's shapes grew new vectors: 2 % of an insert's
+    /// instructions, BENCHMARK.md, "Speed", session 27). Runs of more than
+    /// `max_runs` shape levels and options are dropped.
+    pub fn clear(&mut self, max_runs: usize) {
+        if self.runs.len() > max_runs {
+            self.runs.clear();
+        }
+        for (_, shapes) in &mut self.runs {
+            shapes.clear();
+        }
+    }
+
     /// A reader of the shapes of `shape`'s ancestors under σ floor
     /// `sigma_floor` and expansion `k` (the options they depend on).
     pub fn reader<'s>(
