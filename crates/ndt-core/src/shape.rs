@@ -136,7 +136,7 @@ pub struct ShapeReader<'m, 's> {
 
 impl ShapeMemo {
     /// Forgets every shape, keeping the storage for the next update's
-    /// (each update's shapes grew new vectors: 2 % of an insert's
+    /// (each update's shapes grew new vectors: 0.4 % of an insert's
     /// instructions, BENCHMARK.md, "Speed", session 27). Runs of more than
     /// `max_runs` shape levels and options are dropped.
     pub fn clear(&mut self, max_runs: usize) {
