@@ -86,21 +86,21 @@ impl Storage {
         spare.ok().flatten().unwrap_or_default()
     }
 
-    /// `n` chunks of each. The chunks' and keys' columns keep what a
-    /// previous use left: each is written before it is read, so the
-    /// results are those of new vectors. [`ScanPairs::set_points`] writes
-    /// every point and clears the padding lanes' pairs; with nothing known
-    /// (emptied here, and again at the first evaluation) every point's
-    /// lane has its pair and kept key written; `cell_keys` writes `fresh`,
-    /// `valid` and `same`. Zeroing the chunks instead took 4.7 % of the
-    /// loop's instructions (BENCHMARK.md, "Speed", session 27).
+    /// `n` chunks of each, keeping what a previous use left: each column
+    /// is written before it is read, so the results are those of new
+    /// vectors. [`ScanPairs::set_points`] writes every point and clears the
+    /// padding lanes' pairs; the first evaluation empties `known` (nothing
+    /// is paired yet), so every point's lane has its pair and kept key
+    /// written; `cell_keys` writes `fresh`, `valid` and `same`. Zeroing the
+    /// chunks instead took 4.7 % of the loop's instructions (BENCHMARK.md,
+    /// "Speed", session 27).
     fn sized(mut self, n: usize) -> Self {
         resize(&mut self.chunks, n, Chunk::default());
         resize(&mut self.keys, n, KeyLanes::default());
+        resize(&mut self.known, n, Known::default());
         resize(&mut self.fresh, n, KeyLanes::default());
-        fill(&mut self.known, n, Known::default());
-        fill(&mut self.valid, n, 0);
-        fill(&mut self.same, n, 0);
+        resize(&mut self.valid, n, 0);
+        resize(&mut self.same, n, 0);
         self
     }
 }
@@ -135,12 +135,6 @@ impl Drop for ScanPairs<'_> {
     }
 }
 
-/// `v` emptied, then `n` copies of `x`: what `vec![x; n]` holds.
-fn fill<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
-    v.clear();
-    v.resize(n, x);
-}
-
 /// `v`'s first `n` as they are, then copies of `x` up to `n`.
 fn resize<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
     v.truncate(n);
@@ -162,20 +156,11 @@ impl<'a> ScanPairs<'a> {
         pairs
     }
 
-    /// The same pairs' storage for other `points` (at most as many as at
-    /// [`ScanPairs::new`]; any more are left out), with nothing paired.
-    fn bind(&mut self, points: &'a [[f64; 2]], weights: Option<&'a [f64]>) {
-        self.set_points(points, weights);
-        for ch in &mut self.store.chunks {
-            for l in 0..LANES {
-                ch.clear_pair(l);
-            }
-        }
-    }
-
-    /// The points of the chunks (padding lanes at the origin, with no pair:
-    /// they add exact zeros), leaving the points' pairs' columns as they
-    /// are.
+    /// The chunks take `points` (at most as many as at [`ScanPairs::new`];
+    /// any more are left out) with nothing paired: padding lanes at the
+    /// origin with no pair (they add exact zeros); the points' lanes keep
+    /// their old pairs' columns, which the next evaluation writes, as it
+    /// knows of no pair (`source` is reset).
     fn set_points(&mut self, points: &'a [[f64; 2]], weights: Option<&'a [f64]>) {
         let n = points.len().div_ceil(LANES).min(self.store.keys.len());
         self.points = points
@@ -284,7 +269,7 @@ pub fn evaluate_streaming(
         // The first block sizes the storage; the next ones reuse it.
         let p = match pairs.as_mut() {
             Some(p) => {
-                p.bind(block, w);
+                p.set_points(block, w);
                 p
             }
             None => pairs.insert(ScanPairs::new(block, w)),

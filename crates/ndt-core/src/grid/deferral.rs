@@ -47,13 +47,11 @@ impl NdtGrid {
     pub(crate) fn end_deferral(&mut self) {
         self.deferring = self.deferring.saturating_sub(1);
         if self.deferring == 0 && !self.pending.is_empty() {
-            let mut fine = std::mem::take(&mut self.pending);
-            let touched = self.pyramid.refresh(&fine);
+            let touched = self.pyramid.refresh(&self.pending);
+            // Emptied, its storage kept for the next deferral.
+            self.pending.clear();
             self.update_prepared(&touched);
             self.pyramid.give_back(touched);
-            // Its storage kept for the next deferral.
-            fine.clear();
-            self.pending = fine;
         }
     }
 }
