@@ -1293,9 +1293,14 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         )
         bundles.append((merged, ref + convergence.starts(rng, 1, 0.05, 2.0)[0]))
 
-    def work(part: Sequence[tuple[F64, F64]], sink: list[F64]) -> None:
+    def work(
+        part: Sequence[tuple[F64, F64]], sink: list[F64], span: list[float] | None = None
+    ) -> None:
+        start = time.perf_counter()
         for p, g in part:
             sink.append(grid.match(p, g).pose)
+        if span is not None:
+            span += [start, time.perf_counter()]
 
     def one(jobs: Sequence[tuple[F64, F64]] = jobs) -> tuple[float, float, list[F64]]:
         sink: list[F64] = []
@@ -1304,10 +1309,17 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             work(jobs, sink)
             return time.perf_counter() - t0, time.process_time() - c0, sink
 
-    def two(jobs: Sequence[tuple[F64, F64]] = jobs) -> tuple[float, float, list[F64]]:
+    def two(
+        jobs: Sequence[tuple[F64, F64]] = jobs,
+    ) -> tuple[float, float, list[F64], float, float]:
+        """Wall and CPU time, the poses in job order, the second thread's start after
+        the clock's (s) and the share of the wall time both threads were matching."""
         sinks: list[list[F64]] = [[], []]
+        spans: list[list[float]] = [[], []]
         halves = [jobs[0::2], jobs[1::2]]
-        ts = [threading.Thread(target=work, args=(h, s)) for h, s in zip(halves, sinks)]
+        ts = [
+            threading.Thread(target=work, args=(h, s, sp)) for h, s, sp in zip(halves, sinks, spans)
+        ]
         with no_gc():
             c0, t0 = time.process_time(), time.perf_counter()
             for t in ts:
@@ -1317,7 +1329,9 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             dt, cpu = time.perf_counter() - t0, time.process_time() - c0
         merged: list[F64] = [np.empty(0)] * len(jobs)
         merged[0::2], merged[1::2] = sinks[0], sinks[1]
-        return dt, cpu, merged
+        late = max(sp[0] for sp in spans)
+        both = max(0.0, min(sp[1] for sp in spans) - late)
+        return dt, cpu, merged, late - t0, both / dt
 
     # Control: the same one-vs-two-thread test on hashlib, which releases the GIL on large
     # buffers; it tells what parallelism the machine had free, whatever ndtgrid does.
@@ -1343,19 +1357,22 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     load = os.getloadavg()
     controls = []
     singles, doubles, cpu1, cpu2 = [], [], [], []
+    lates, overlaps = [], []
     bundle_1, bundle_2 = [], []
     same = True
     for _ in progress(range(args.thread_reps), "threads"):
         t1, c1, r1 = one()
-        t2, c2, r2 = two()
+        t2, c2, r2, late, overlap = two()
         singles.append(t1)
         doubles.append(t2)
         cpu1.append(c1 / t1)
         cpu2.append(c2 / t2)
+        lates.append(late)
+        overlaps.append(overlap)
         same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
         controls.append(control())
         t1, _, r1 = one(bundles)
-        t2, _, r2 = two(bundles)
+        t2, _, r2, _, _ = two(bundles)
         bundle_1.append(t1)
         bundle_2.append(t2)
         same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
@@ -1381,6 +1398,17 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             f"| 1 | {s1:.0f} | {b1:.0f} | {np.median(cpu1):.2f} |",
             f"| 2 | {s2:.0f} | {b2:.0f} | {np.median(cpu2):.2f} |",
             f"| ratio | {s2 / s1:.2f}× | {b2 / b1:.2f}× | |",
+            "",
+            "Per run (one thread's time over the two threads' time right after it): "
+            f"{', '.join(f'{a / b:.2f}' for a, b in zip(singles, doubles))}; median "
+            f"{float(np.median(np.divide(singles, doubles))):.2f}×. Two threads' CPU / wall "
+            f"per run: {', '.join(f'{c:.2f}' for c in cpu2)}. The second thread's first "
+            "match began "
+            f"{', '.join(f'{1e3 * x:.1f}' for x in lates)} ms after the clock started (a "
+            "new thread waits for the GIL, which the first one takes back between its "
+            "matches); both threads were matching during "
+            f"{', '.join(f'{100 * x:.0f}' for x in overlaps)} % of the run (the rest: one "
+            "thread started late or finished early).",
             "",
             "Control, run after each pair of runs: SHA-256 of a 1 MiB buffer (`hashlib` "
             "releases the GIL), 128 hashes on one thread against 64 on each of two: "
