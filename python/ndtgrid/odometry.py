@@ -189,8 +189,8 @@ class OdometryConfig:
         §V settings go unused, and :attr:`Odometry.mapper` raises ``RuntimeError``. The
         poses are the same bit for bit (they never depend on the map unless
         ``match_filtered_map``, which needs it: ``ValueError``). On the Intel log it
-        used 37-43 % of the default's CPU time, both threads counted, and 64-94 % of its
-        wall time (``BENCHMARK.md``, "Speed", session 21).
+        used 50-55 % of the default's CPU time, both threads counted, and 86-102 % of
+        its wall time (``BENCHMARK.md``, "Speed", session 28).
     """
 
     min_range: float = 0.0

@@ -246,9 +246,10 @@ pub struct OdometryConfig {
     /// `insert_distance`, `insert_angle`, `map_window` and the mapper
     /// options unused); the poses are the same bit for bit, since they never
     /// depend on the map ([`OdometryConfig::match_filtered_map`] aside,
-    /// which needs it). On the Intel log it used 37–43 % of the default's
-    /// CPU time, both threads counted, and 64–94 % of its wall time
-    /// (BENCHMARK.md, "Speed", session 21).
+    /// which needs it). On the Intel log it used 50–55 % of the default's
+    /// CPU time, both threads counted, and 86–102 % of its wall time
+    /// (BENCHMARK.md, "Speed", session 28; 37–43 % and 64–94 % in session
+    /// 21).
     pub build_map: bool,
 }
 
