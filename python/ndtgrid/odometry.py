@@ -189,7 +189,7 @@ class OdometryConfig:
         §V settings go unused, and :attr:`Odometry.mapper` raises ``RuntimeError``. The
         poses are the same bit for bit (they never depend on the map unless
         ``match_filtered_map``, which needs it: ``ValueError``). On the Intel log it
-        used 50-55 % of the default's CPU time, both threads counted, and 86-102 % of
+        used 50-55 % of the default's CPU time, both threads counted, and 86-103 % of
         its wall time (``BENCHMARK.md``, "Speed", session 28).
     """
 

@@ -247,7 +247,7 @@ pub struct OdometryConfig {
     /// options unused); the poses are the same bit for bit, since they never
     /// depend on the map ([`OdometryConfig::match_filtered_map`] aside,
     /// which needs it). On the Intel log it used 50–55 % of the default's
-    /// CPU time, both threads counted, and 86–102 % of its wall time
+    /// CPU time, both threads counted, and 86–103 % of its wall time
     /// (BENCHMARK.md, "Speed", session 28; 37–43 % and 64–94 % in session
     /// 21).
     pub build_map: bool,
