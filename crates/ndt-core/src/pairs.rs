@@ -95,12 +95,13 @@ impl Storage {
     /// chunks instead took 4.7 % of the loop's instructions (BENCHMARK.md,
     /// "Speed", session 27).
     fn sized(mut self, n: usize) -> Self {
-        resize(&mut self.chunks, n, Chunk::default());
-        resize(&mut self.keys, n, KeyLanes::default());
-        resize(&mut self.known, n, Known::default());
-        resize(&mut self.fresh, n, KeyLanes::default());
-        resize(&mut self.valid, n, 0);
-        resize(&mut self.same, n, 0);
+        // `resize` keeps the first `n` as they are (truncating any more).
+        self.chunks.resize(n, Chunk::default());
+        self.keys.resize(n, KeyLanes::default());
+        self.known.resize(n, Known::default());
+        self.fresh.resize(n, KeyLanes::default());
+        self.valid.resize(n, 0);
+        self.same.resize(n, 0);
         self
     }
 }
@@ -133,12 +134,6 @@ impl Drop for ScanPairs<'_> {
             }
         });
     }
-}
-
-/// `v`'s first `n` as they are, then copies of `x` up to `n`.
-fn resize<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
-    v.truncate(n);
-    v.resize(n, x);
 }
 
 impl<'a> ScanPairs<'a> {
