@@ -28,9 +28,11 @@ as a Markdown table to stdout as soon as it is measured (progress goes to stderr
    turn); linear fits; a plot in ``docs/img/speed_sweeps.png`` when matplotlib is
    installed.
 5. **Threads**: matches per second of two Python threads matching different scans
-   against one grid, against one thread; two GIL-free controls in the same run (SHA-256,
-   and our matcher on bundles of 20 scans merged into one, whose calls are long enough
-   that the GIL hardly matters).
+   against one grid, against one thread, twice: threads started for each run where the
+   kernel puts them, and two long-lived worker threads pinned to the two cores
+   (``benches/pinned.py``); two GIL-free controls in the same run (SHA-256, and our
+   matcher on bundles of 20 scans merged into one, whose calls are long enough that the
+   GIL hardly matters).
 6. **Memory**: bytes per occupied fine cell (RSS growth of a fresh child process divided by
    ``len(grid)``) before and after the distributions are built.
 
@@ -74,6 +76,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import convergence
 import datasets
 import peers as peer_lib
+import pinned
 
 import ndtgrid
 from ndtgrid import se2, sim
@@ -1354,11 +1357,38 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             h.join()
         return one_t / (time.perf_counter() - t0)
 
+    # The same runs on two long-lived worker threads, each pinned to its own core
+    # (benches/pinned.py): one worker alone, then both. Timed from the first worker's
+    # first match to the last one's end, so the barrier's hand-out is not counted, but
+    # a worker that begins late is.
+    cpus = pinned.two_cpus()
+    workers = pinned.PinnedWorkers(cpus) if cpus is not None else None
+    pin_sinks: list[list[F64]] = [[], []]
+    pin_spans: list[list[float]] = [[], []]
+
+    def pinned_run(parts: Sequence[Sequence[tuple[F64, F64]] | None]) -> tuple[float, float]:
+        """Wall time of one pinned round (``parts[i]``: worker i's scans, ``None``: it
+        sits out) and the later worker's start after the first's (s)."""
+        assert workers is not None
+        for sink, span in zip(pin_sinks, pin_spans):
+            sink.clear()
+            span.clear()
+        tasks = [
+            None if part is None else functools.partial(work, part, sink, span)
+            for part, sink, span in zip(parts, pin_sinks, pin_spans)
+        ]
+        with no_gc():
+            workers.run(tasks)
+        spans = [sp for sp in pin_spans if sp]
+        t0 = min(sp[0] for sp in spans)
+        return max(sp[1] for sp in spans) - t0, max(sp[0] for sp in spans) - t0
+
     load = os.getloadavg()
     controls = []
     singles, doubles, cpu1, cpu2 = [], [], [], []
     lates, overlaps = [], []
     bundle_1, bundle_2 = [], []
+    pin_1, pin_2, pin_lates = [], [], []
     same = True
     for _ in progress(range(args.thread_reps), "threads"):
         t1, c1, r1 = one()
@@ -1376,10 +1406,47 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         bundle_1.append(t1)
         bundle_2.append(t2)
         same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
+        if workers is not None:
+            t1, _ = pinned_run([jobs, None])
+            r1 = list(pin_sinks[0])
+            t2, late = pinned_run([jobs[0::2], jobs[1::2]])
+            r2 = [np.empty(0)] * len(jobs)
+            r2[0::2], r2[1::2] = pin_sinks[0], pin_sinks[1]
+            pin_1.append(t1)
+            pin_2.append(t2)
+            pin_lates.append(late)
+            same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
+    if workers is not None:
+        workers.close()
     n = len(jobs)
     s1, s2 = n / np.median(singles), n / np.median(doubles)
     b1, b2 = n / min(singles), n / min(doubles)
     bundle_ratio = float(np.median(bundle_1) / np.median(bundle_2))
+    if pin_1 and cpus is not None:
+        p1, p2 = n / np.median(pin_1), n / np.median(pin_2)
+        pb1, pb2 = n / min(pin_1), n / min(pin_2)
+        pin_rows = [
+            f"| 1, pinned worker | {p1:.0f} | {pb1:.0f} | |",
+            f"| 2, pinned workers | {p2:.0f} | {pb2:.0f} | |",
+            f"| ratio, pinned | {p2 / p1:.2f}× | {pb2 / pb1:.2f}× | |",
+        ]
+        pin_text = [
+            "",
+            "Pinned: the same scans on two long-lived worker threads, each pinned to its "
+            f"own core (CPUs {cpus[0]} and {cpus[1]}, `os.sched_setaffinity(0, {{cpu}})` "
+            "in the worker; `benches/pinned.py`), let go together from a barrier: one "
+            "worker alone, then both, right after each pair of runs above; timed from "
+            "the first worker's first match to the last one's end. Per run: "
+            f"{', '.join(f'{a / b:.2f}' for a, b in zip(pin_1, pin_2))}; median "
+            f"{float(np.median(np.divide(pin_1, pin_2))):.2f}×. The later worker's first "
+            "match began "
+            f"{', '.join(f'{1e6 * x:.0f}' for x in pin_lates)} µs after the first's. "
+            "Unpinned, this VM's kernel may wake a thread on the vCPU of the busy thread "
+            "that woke it, with the other vCPU idle; it then waits there for the "
+            'scheduler\'s tick or shares that vCPU (BENCHMARK.md, "Speed", session 29).',
+        ]
+    else:
+        pin_rows, pin_text = [], ["", "Pinned workers: not measured (no two CPUs to pin to)."]
     bundle_points = int(np.median([len(p) for p, _ in bundles]))
     out(
         [
@@ -1398,6 +1465,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             f"| 1 | {s1:.0f} | {b1:.0f} | {np.median(cpu1):.2f} |",
             f"| 2 | {s2:.0f} | {b2:.0f} | {np.median(cpu2):.2f} |",
             f"| ratio | {s2 / s1:.2f}× | {b2 / b1:.2f}× | |",
+            *pin_rows,
             "",
             "Per run (one thread's time over the two threads' time right after it): "
             f"{', '.join(f'{a / b:.2f}' for a, b in zip(singles, doubles))}; median "
@@ -1428,11 +1496,14 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             "the two threads of single scans can reach on these cores in this run; below "
             "it, the cost is the GIL's (held for the argument conversion, the result and "
             "the Python loop, a few µs per match).",
+            *pin_text,
         ]
     )
     return {
         "ratio": s2 / s1,
         "ratio_best": b2 / b1,
+        "pinned_ratio": p2 / p1 if pin_1 else math.nan,
+        "pinned_ratio_best": pb2 / pb1 if pin_1 else math.nan,
         "load": load[0],
         "control": float(np.median(controls)),
         "bundle_ratio": bundle_ratio,
@@ -1626,11 +1697,19 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
     t = res.get("threads", {})
     if t:
         row(
-            "two threads ≥ 1.7× one",
+            "two threads ≥ 1.7× one (threads started for each run, placed by the kernel)",
             f"{t['ratio']:.2f}× (best runs {t['ratio_best']:.2f}×; GIL-free controls: "
             f"SHA-256 {t['control']:.2f}×, our matcher on {THREAD_BUNDLE}-scan bundles "
             f"{t['bundle_ratio']:.2f}×)",
             t["ratio"] >= 1.7,
+        )
+        pr = t.get("pinned_ratio", math.nan)
+        row(
+            "two threads ≥ 1.7× one, the threads pinned to the two cores",
+            "not measured"
+            if math.isnan(pr)
+            else f"{pr:.2f}× (best runs {t['pinned_ratio_best']:.2f}×)",
+            None if math.isnan(pr) else pr >= 1.7,
         )
     mem = res.get("memory", {})
     if mem:

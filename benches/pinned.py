@@ -1,0 +1,120 @@
+"""Long-lived Python worker threads, each pinned to its own core, run by run.
+
+For the thread section of ``benches/speed.py``. On this project's VM the kernel places a
+thread woken by a busy thread on the waker's own vCPU, even with the other vCPU idle
+(``sched_switch`` / ``sched_wakeup`` traces in BENCHMARK.md, "Speed", session 29): the
+second of two matching threads then waits there for the scheduler tick (4 ms at
+``CONFIG_HZ=250``) or shares that vCPU for a while. A thread pinned to its own core
+cannot be placed on the other's, which is what a program that wants two cores' worth of
+matching does with its worker threads on Linux (``os.sched_setaffinity(0, {cpu})`` in
+each worker; 0 is the calling thread).
+
+Each worker pins itself once, then waits at a barrier; :meth:`PinnedWorkers.run` hands
+every worker its task (or none), lets them go together and returns when all are done.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from collections.abc import Callable, Sequence
+from types import TracebackType
+
+Task = Callable[[], None]
+
+
+def two_cpus() -> list[int] | None:
+    """The first two CPUs this process may run on, or ``None`` where threads cannot be
+    pinned (no ``os.sched_setaffinity``: not Linux) or fewer than two are allowed."""
+    if not hasattr(os, "sched_setaffinity"):
+        return None
+    cpus = sorted(os.sched_getaffinity(0))
+    return cpus[:2] if len(cpus) >= 2 else None
+
+
+class PinnedWorkers:
+    """One thread per CPU of ``cpus``, each pinned to it, started at once and kept until
+    :meth:`close` (or the end of a ``with`` block).
+
+    Parameters
+    ----------
+    cpus : sequence of int
+        The CPU of each worker (distinct, allowed for this process).
+    """
+
+    def __init__(self, cpus: Sequence[int]) -> None:
+        self._cpus = list(cpus)
+        n = len(self._cpus)
+        self._go = threading.Barrier(n + 1)
+        self._done = threading.Barrier(n + 1)
+        self._tasks: list[Task | None] = [None] * n
+        self._errors: list[BaseException] = []
+        self._stop = False
+        self._threads = [
+            threading.Thread(target=self._loop, args=(i,), daemon=True) for i in range(n)
+        ]
+        for t in self._threads:
+            t.start()
+        # The first round only checks that every worker pinned itself.
+        try:
+            self.run([None] * n)
+        except BaseException:
+            self.close()
+            raise
+
+    def _loop(self, i: int) -> None:
+        try:
+            os.sched_setaffinity(0, {self._cpus[i]})
+        except OSError as e:
+            self._errors.append(e)
+        while True:
+            self._go.wait()
+            if self._stop:
+                return
+            task = self._tasks[i]
+            if task is not None:
+                try:
+                    task()
+                except BaseException as e:  # handed to the caller of run()
+                    self._errors.append(e)
+            self._done.wait()
+
+    def run(self, tasks: Sequence[Task | None]) -> None:
+        """Runs ``tasks[i]`` on worker ``i`` (``None``: that worker sits this round
+        out), all let go at once; returns when every worker is done.
+
+        Raises
+        ------
+        ValueError
+            If ``tasks`` does not have one entry per worker.
+        Exception
+            The first exception a task (or a worker's pinning) raised.
+        """
+        if len(tasks) != len(self._threads):
+            raise ValueError(f"{len(tasks)} tasks for {len(self._threads)} workers")
+        self._tasks = list(tasks)
+        self._go.wait()
+        self._done.wait()
+        if self._errors:
+            err, self._errors = self._errors[0], []
+            raise err
+
+    def close(self) -> None:
+        """Lets the workers end and waits for them."""
+        if self._stop:
+            return
+        self._stop = True
+        self._go.wait()
+        for t in self._threads:
+            t.join()
+
+    def __enter__(self) -> PinnedWorkers:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
