@@ -1366,29 +1366,40 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     pin_sinks: list[list[F64]] = [[], []]
     pin_spans: list[list[float]] = [[], []]
 
-    def pinned_run(parts: Sequence[Sequence[tuple[F64, F64]] | None]) -> tuple[float, float]:
+    def pinned_run(
+        parts: Sequence[Sequence[tuple[F64, F64]] | None],
+    ) -> tuple[float, float, float]:
         """Wall time of one pinned round (``parts[i]``: worker i's scans, ``None``: it
-        sits out) and the later worker's start after the first's (s)."""
+        sits out), the later worker's start after the first's (s), and the workers'
+        CPU time (``time.thread_time``) over the wall time."""
         assert workers is not None
+        cpu: list[float] = []
+
+        def task(part: Sequence[tuple[F64, F64]], sink: list[F64], span: list[float]) -> None:
+            c0 = time.thread_time()
+            work(part, sink, span)
+            cpu.append(time.thread_time() - c0)
+
         for sink, span in zip(pin_sinks, pin_spans):
             sink.clear()
             span.clear()
         tasks = [
-            None if part is None else functools.partial(work, part, sink, span)
+            None if part is None else functools.partial(task, part, sink, span)
             for part, sink, span in zip(parts, pin_sinks, pin_spans)
         ]
         with no_gc():
             workers.run(tasks)
         spans = [sp for sp in pin_spans if sp]
         t0 = min(sp[0] for sp in spans)
-        return max(sp[1] for sp in spans) - t0, max(sp[0] for sp in spans) - t0
+        wall = max(sp[1] for sp in spans) - t0
+        return wall, max(sp[0] for sp in spans) - t0, sum(cpu) / wall
 
     load = os.getloadavg()
     controls = []
     singles, doubles, cpu1, cpu2 = [], [], [], []
     lates, overlaps = [], []
     bundle_1, bundle_2 = [], []
-    pin_1, pin_2, pin_lates = [], [], []
+    pin_1, pin_2, pin_lates, pin_cpu1, pin_cpu2 = [], [], [], [], []
     same = True
     for rep in progress(range(args.thread_reps), "threads"):
         t1, c1, r1 = one()
@@ -1409,9 +1420,11 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         if workers is not None:
             # One worker alone, on the two cores in turn (one may be slower).
             alone = rep % 2
-            t1, _ = pinned_run([None, jobs] if alone else [jobs, None])
+            t1, _, c1 = pinned_run([None, jobs] if alone else [jobs, None])
             r1 = list(pin_sinks[alone])
-            t2, late = pinned_run([jobs[0::2], jobs[1::2]])
+            t2, late, c2 = pinned_run([jobs[0::2], jobs[1::2]])
+            pin_cpu1.append(c1)
+            pin_cpu2.append(c2)
             r2 = [np.empty(0)] * len(jobs)
             r2[0::2], r2[1::2] = pin_sinks[0], pin_sinks[1]
             pin_1.append(t1)
@@ -1432,8 +1445,8 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         pb1, pb2 = max(n / min(pin_1), b1), n / min(pin_2)
         pin_rows = [
             f"| 1, pinned worker (cores in turn) | {n / np.median(pin_1):.0f} "
-            f"| {n / min(pin_1):.0f} | |",
-            f"| 2, pinned workers | {p2:.0f} | {pb2:.0f} | |",
+            f"| {n / min(pin_1):.0f} | {np.median(pin_cpu1):.2f} |",
+            f"| 2, pinned workers | {p2:.0f} | {pb2:.0f} | {np.median(pin_cpu2):.2f} |",
             f"| ratio, pinned (against the faster one-thread row) | {p2 / p1:.2f}× "
             f"| {pb2 / pb1:.2f}× | |",
         ]
@@ -1447,7 +1460,8 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             "end. The ratio is taken against the faster of the two one-thread rows. "
             "Per run (one pinned worker's time over the two's right after it): "
             f"{', '.join(f'{a / b:.2f}' for a, b in zip(pin_1, pin_2))}; median "
-            f"{float(np.median(np.divide(pin_1, pin_2))):.2f}×. The later worker's first "
+            f"{float(np.median(np.divide(pin_1, pin_2))):.2f}×; the two workers' CPU / "
+            f"wall per run: {', '.join(f'{c:.2f}' for c in pin_cpu2)}. The later worker's first "
             "match began "
             f"{', '.join(f'{1e6 * x:.0f}' for x in pin_lates)} µs after the first's. "
             "Unpinned, this VM's kernel may wake a thread on the vCPU of the busy thread "
