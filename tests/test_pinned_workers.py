@@ -86,7 +86,7 @@ def test_a_tasks_error_reaches_the_caller_and_the_workers_go_on() -> None:
 
     ran: list[int] = []
     with pinned.PinnedWorkers(CPUS) as workers:
-        with pytest.raises(RuntimeError, match="^task failed$"):
+        with pytest.raises(RuntimeError, match=r"^task failed$"):
             workers.run([boom, None])
         workers.run([lambda: ran.append(0), lambda: ran.append(1)])
         with pytest.raises(ValueError, match=r"^1 tasks for 2 workers$"):
