@@ -1,7 +1,8 @@
-"""The README's runnable example and the command line's entry points."""
+"""The runnable examples and the command line's entry points."""
 
 from __future__ import annotations
 
+import os
 import re
 import subprocess
 import sys
@@ -12,18 +13,36 @@ import ndtgrid
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def test_quickstart_recovers_the_pose() -> None:
-    out = subprocess.run(
-        [sys.executable, str(ROOT / "examples" / "quickstart.py")],
+def run_example(name: str) -> str:
+    """The standard output of ``examples/<name>``, run as a user would."""
+    return subprocess.run(
+        [sys.executable, str(ROOT / "examples" / name)],
         capture_output=True,
         text=True,
         check=True,
     ).stdout
+
+
+def test_quickstart_recovers_the_pose() -> None:
+    out = run_example("quickstart.py")
     assert "converged=True" in out
     m = re.search(r"error \[mm, deg\]: (\S+) (\S+)", out)
     assert m is not None, out
     assert float(m.group(1)) < 1.0
     assert abs(float(m.group(2))) < 0.05
+
+
+def test_threads_example_pins_its_workers_and_matches_alike() -> None:
+    out = run_example("threads.py")
+    assert "same poses: True" in out, out
+    m = re.search(r"worker CPUs: (\[.*\])", out)
+    assert m is not None, out
+    cpus = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
+    if len(cpus) >= 2:
+        assert m.group(1) == f"[[{cpus[0]}], [{cpus[1]}]]"
+    else:
+        assert m.group(1) == "[]"
+    assert re.search(r"one thread: \d+ matches/s", out), out
 
 
 def test_version_from_the_command_line() -> None:
