@@ -32,7 +32,8 @@ as a Markdown table to stdout as soon as it is measured (progress goes to stderr
    kernel puts them, and two long-lived worker threads pinned to the two cores
    (``benches/pinned.py``); two GIL-free controls in the same run (SHA-256, and our
    matcher on bundles of 20 scans merged into one, whose calls are long enough that the
-   GIL hardly matters).
+   GIL hardly matters); each run's ratios and late starts in
+   ``docs/img/speed_threads.png`` when matplotlib is installed.
 6. **Memory**: bytes per occupied fine cell (RSS growth of a fresh child process divided by
    ``len(grid)``) before and after the distributions are built.
 
@@ -1268,6 +1269,59 @@ def plot_sweeps(res: dict[str, Any], path: Path) -> None:
     out(f"\nPlot: `{shown}`.")
 
 
+def plot_threads(runs: dict[str, list[float]], path: Path) -> None:
+    """The thread section's runs as a PNG (skipped without matplotlib): each run's
+    ratio (one thread's time over two threads' right after it) for the unpinned and
+    pinned threads and the two GIL-free controls; when the later thread began."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        out("\n(matplotlib absent: no plot.)")
+        return
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.8))
+    for key, marker, label in (
+        ("unpinned", "o", "two threads started per run"),
+        ("pinned", "s", "two pinned workers"),
+        ("sha", "x", "control: SHA-256 (GIL released)"),
+        ("bundles", "+", "control: 20-scan bundles"),
+    ):
+        ys = runs.get(key, [])
+        if ys:
+            a.plot(np.arange(1, len(ys) + 1), ys, marker, label=label, alpha=0.85)
+    a.axhline(1.7, color="k", lw=0.8, ls="--", label="target 1.7×")
+    a.axhline(2.0, color="0.6", lw=0.8)
+    a.set_xlabel("run (one- and two-thread runs alternate)")
+    a.set_ylabel("one thread's time / two threads' time")
+    a.set_title("Speed-up per run")
+    a.xaxis.get_major_locator().set_params(integer=True)
+    a.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.16))
+    for key, marker, label in (
+        ("late_unpinned", "o", "started per run (after the clock)"),
+        ("late_pinned", "s", "pinned (after the first worker)"),
+    ):
+        ys = runs.get(key, [])
+        if ys:
+            b.plot(np.arange(1, len(ys) + 1), 1e3 * np.maximum(ys, 1e-6), marker, label=label)
+    b.axhline(4.0, color="k", lw=0.8, ls="--", label="scheduler tick (HZ = 250)")
+    b.set_yscale("log")
+    b.set_xlabel("run")
+    b.set_ylabel("later thread's first match began [ms]")
+    b.set_title("Late starts")
+    b.xaxis.get_major_locator().set_params(integer=True)
+    b.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))
+    fig.suptitle("Two Python threads matching different scans on one 2 cm map (benches/speed.py)")
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    full = path.resolve()
+    shown = full.relative_to(ROOT) if full.is_relative_to(ROOT) else path
+    plt.close(fig)
+    out(f"\nPlot: `{shown}`.")
+
+
 # ----------------------------------------------------------------------------- 5. threads
 
 
@@ -1522,6 +1576,18 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             *pin_text,
         ]
     )
+    if args.plot_threads:
+        plot_threads(
+            {
+                "unpinned": list(np.divide(singles, doubles)),
+                "pinned": list(np.divide(pin_1, pin_2)),
+                "sha": controls,
+                "bundles": list(np.divide(bundle_1, bundle_2)),
+                "late_unpinned": lates,
+                "late_pinned": pin_lates,
+            },
+            Path(args.plot_threads),
+        )
     return {
         "ratio": s2 / s1,
         "ratio_best": b2 / b1,
@@ -1774,6 +1840,11 @@ def main() -> int:
         "--plot",
         help="sweep plot path (default docs/img/speed_sweeps.png; none with --quick unless given)",
     )
+    ap.add_argument(
+        "--plot-threads",
+        help="thread plot path (default docs/img/speed_threads.png; none with --quick unless "
+        "given)",
+    )
     ap.add_argument("--intel-child", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--one-thread", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--poses-only", action="store_true", help=argparse.SUPPRESS)
@@ -1795,6 +1866,8 @@ def main() -> int:
             setattr(args, k, v)
     if args.plot is None and not q:
         args.plot = str(ROOT / "docs" / "img" / "speed_sweeps.png")
+    if args.plot_threads is None and not q:
+        args.plot_threads = str(ROOT / "docs" / "img" / "speed_threads.png")
     args.sweep_points = [100, 683, 2000] if q else [100, 200, 400, 683, 1000, 2000, 4000]
     args.sweep_maps = 3 if q else 8
     args.sweep_tests = 5 if q else 20
