@@ -11,7 +11,7 @@ Runnable as is (simulated URG-04LX scans of the paper's sticks room, no data nee
 prints the matches per second of one thread and of two pinned workers, and checks that
 both give the same poses, bit for bit. The gain is what the two cores have free: on this
 project's 2-vCPU VM, 1.4-1.5x in a phase in which the VM gave GIL-free work (SHA-256)
-1.5x, and 1.59-2.00x over ten runs of ``benches/speed.py``'s thread section.
+1.5x, and 1.59-2.00x over thirteen runs of ``benches/speed.py``'s thread section.
 """
 
 import itertools
