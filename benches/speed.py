@@ -1455,38 +1455,40 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     bundle_1, bundle_2 = [], []
     pin_1, pin_2, pin_lates, pin_cpu1, pin_cpu2 = [], [], [], [], []
     same = True
-    for rep in progress(range(args.thread_reps), "threads"):
-        t1, c1, r1 = one()
-        t2, c2, r2, late, overlap = two()
-        singles.append(t1)
-        doubles.append(t2)
-        cpu1.append(c1 / t1)
-        cpu2.append(c2 / t2)
-        lates.append(late)
-        overlaps.append(overlap)
-        same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
-        controls.append(control())
-        t1, _, r1 = one(bundles)
-        t2, _, r2, _, _ = two(bundles)
-        bundle_1.append(t1)
-        bundle_2.append(t2)
-        same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
-        if workers is not None:
-            # One worker alone, on the two cores in turn (one may be slower).
-            alone = rep % 2
-            t1, _, c1 = pinned_run([None, jobs] if alone else [jobs, None])
-            r1 = list(pin_sinks[alone])
-            t2, late, c2 = pinned_run([jobs[0::2], jobs[1::2]])
-            pin_cpu1.append(c1)
-            pin_cpu2.append(c2)
-            r2 = [np.empty(0)] * len(jobs)
-            r2[0::2], r2[1::2] = pin_sinks[0], pin_sinks[1]
-            pin_1.append(t1)
-            pin_2.append(t2)
-            pin_lates.append(late)
+    try:
+        for rep in progress(range(args.thread_reps), "threads"):
+            t1, c1, r1 = one()
+            t2, c2, r2, late, overlap = two()
+            singles.append(t1)
+            doubles.append(t2)
+            cpu1.append(c1 / t1)
+            cpu2.append(c2 / t2)
+            lates.append(late)
+            overlaps.append(overlap)
             same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
-    if workers is not None:
-        workers.close()
+            controls.append(control())
+            t1, _, r1 = one(bundles)
+            t2, _, r2, _, _ = two(bundles)
+            bundle_1.append(t1)
+            bundle_2.append(t2)
+            same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
+            if workers is not None:
+                # One worker alone, on the two cores in turn (one may be slower).
+                alone = rep % 2
+                t1, _, c1 = pinned_run([None, jobs] if alone else [jobs, None])
+                r1 = list(pin_sinks[alone])
+                t2, late, c2 = pinned_run([jobs[0::2], jobs[1::2]])
+                pin_cpu1.append(c1)
+                pin_cpu2.append(c2)
+                r2 = [np.empty(0)] * len(jobs)
+                r2[0::2], r2[1::2] = pin_sinks[0], pin_sinks[1]
+                pin_1.append(t1)
+                pin_2.append(t2)
+                pin_lates.append(late)
+                same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
+    finally:
+        if workers is not None:
+            workers.close()
     n = len(jobs)
     s1, s2 = n / np.median(singles), n / np.median(doubles)
     b1, b2 = n / min(singles), n / min(doubles)
