@@ -69,8 +69,11 @@ one = match_all(jobs)
 t_one = time.perf_counter() - t0
 
 with ThreadPoolExecutor(max_workers=workers, initializer=pin) as pool:
-    # Start the workers (and pin them) before the clock starts.
-    list(pool.map(lambda _: None, range(workers)))
+    # Start the workers (and pin them) before the clock starts: each waits for the
+    # other, so the pool must start them all.
+    ready = threading.Barrier(workers)
+    list(pool.map(lambda _: ready.wait(), range(workers)))
+    assert len(pinned) == (workers if len(cpus) >= 2 else 0)
     t0 = time.perf_counter()
     halves = [pool.submit(match_all, jobs[i::workers]) for i in range(workers)]
     parts = [h.result() for h in halves]
