@@ -1224,8 +1224,9 @@ def section_sweeps(args: argparse.Namespace) -> dict[str, Any]:
     return res
 
 
-def plot_sweeps(res: dict[str, Any], path: Path) -> None:
-    """The two sweeps as a PNG (skipped without matplotlib)."""
+def pyplot() -> Any:
+    """``matplotlib.pyplot`` with the Agg backend, or ``None`` (said in the output) when
+    matplotlib is absent."""
     try:
         import matplotlib
 
@@ -1233,6 +1234,29 @@ def plot_sweeps(res: dict[str, Any], path: Path) -> None:
         import matplotlib.pyplot as plt
     except ImportError:
         out("\n(matplotlib absent: no plot.)")
+        return None
+    return plt
+
+
+def save_figure(fig: Any, title: str, path: Path) -> None:
+    """Titles, lays out, writes (creating the directory) and closes ``fig``; names the
+    file in the output."""
+    import matplotlib.pyplot as plt
+
+    fig.suptitle(title)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    full = path.resolve()
+    shown = full.relative_to(ROOT) if full.is_relative_to(ROOT) else path
+    plt.close(fig)
+    out(f"\nPlot: `{shown}`.")
+
+
+def plot_sweeps(res: dict[str, Any], path: Path) -> None:
+    """The two sweeps as a PNG (skipped without matplotlib)."""
+    plt = pyplot()
+    if plt is None:
         return
     rows, slope, icpt, r2 = res["points"]
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
@@ -1259,27 +1283,15 @@ def plot_sweeps(res: dict[str, Any], path: Path) -> None:
     b.set_title("Map size (same Intel scans)")
     b.set_ylim(bottom=0)
     b.legend()
-    fig.suptitle("ndtgrid default match() on a 2 cm grid, one thread (benches/speed.py)")
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    full = path.resolve()
-    shown = full.relative_to(ROOT) if full.is_relative_to(ROOT) else path
-    plt.close(fig)
-    out(f"\nPlot: `{shown}`.")
+    save_figure(fig, "ndtgrid default match() on a 2 cm grid, one thread (benches/speed.py)", path)
 
 
 def plot_threads(runs: dict[str, list[float]], path: Path) -> None:
     """The thread section's runs as a PNG (skipped without matplotlib): each run's
     ratio (one thread's time over two threads' right after it) for the unpinned and
     pinned threads and the two GIL-free controls; when the later thread began."""
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        out("\n(matplotlib absent: no plot.)")
+    plt = pyplot()
+    if plt is None:
         return
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.8))
     for key, marker, label in (
@@ -1312,14 +1324,9 @@ def plot_threads(runs: dict[str, list[float]], path: Path) -> None:
     b.set_title("Late starts")
     b.xaxis.get_major_locator().set_params(integer=True)
     b.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))
-    fig.suptitle("Two Python threads matching different scans on one 2 cm map (benches/speed.py)")
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    full = path.resolve()
-    shown = full.relative_to(ROOT) if full.is_relative_to(ROOT) else path
-    plt.close(fig)
-    out(f"\nPlot: `{shown}`.")
+    save_figure(
+        fig, "Two Python threads matching different scans on one 2 cm map (benches/speed.py)", path
+    )
 
 
 # ----------------------------------------------------------------------------- 5. threads
