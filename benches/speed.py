@@ -1373,6 +1373,13 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             work(jobs, sink)
             return time.perf_counter() - t0, time.process_time() - c0, sink
 
+    def in_job_order(halves: Sequence[list[F64]]) -> list[F64]:
+        """The poses of the two threads' halves (``jobs[0::2]``, ``jobs[1::2]``) back
+        in job order."""
+        merged: list[F64] = [np.empty(0)] * (len(halves[0]) + len(halves[1]))
+        merged[0::2], merged[1::2] = halves[0], halves[1]
+        return merged
+
     def two(
         jobs: Sequence[tuple[F64, F64]] = jobs,
     ) -> tuple[float, float, list[F64], float, float]:
@@ -1391,11 +1398,9 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             for t in ts:
                 t.join()
             dt, cpu = time.perf_counter() - t0, time.process_time() - c0
-        merged: list[F64] = [np.empty(0)] * len(jobs)
-        merged[0::2], merged[1::2] = sinks[0], sinks[1]
         late = max(sp[0] for sp in spans)
         both = max(0.0, min(sp[1] for sp in spans) - late)
-        return dt, cpu, merged, late - t0, both / dt
+        return dt, cpu, in_job_order(sinks), late - t0, both / dt
 
     # Control: the same one-vs-two-thread test on hashlib, which releases the GIL on large
     # buffers; it tells what parallelism the machine had free, whatever ndtgrid does.
@@ -1487,8 +1492,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
                 t2, late, c2 = pinned_run([jobs[0::2], jobs[1::2]])
                 pin_cpu1.append(c1)
                 pin_cpu2.append(c2)
-                r2 = [np.empty(0)] * len(jobs)
-                r2[0::2], r2[1::2] = pin_sinks[0], pin_sinks[1]
+                r2 = in_job_order(pin_sinks)
                 pin_1.append(t1)
                 pin_2.append(t2)
                 pin_lates.append(late)
@@ -1500,6 +1504,12 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     s1, s2 = n / np.median(singles), n / np.median(doubles)
     b1, b2 = n / min(singles), n / min(doubles)
     bundle_ratio = float(np.median(bundle_1) / np.median(bundle_2))
+    # Each run's ratio: one thread's time over the two threads' right after it.
+    per_run = {
+        "unpinned": list(np.divide(singles, doubles)),
+        "pinned": list(np.divide(pin_1, pin_2)),
+        "bundles": list(np.divide(bundle_1, bundle_2)),
+    }
     if pin_1 and cpus is not None:
         # Judged against the faster of the two one-thread baselines (pinned, cores in
         # turn; unpinned, where the kernel put it), so that a slow core alone cannot
@@ -1522,8 +1532,8 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             "of runs above; timed from the first worker's first match to the last one's "
             "end. The ratio is taken against the faster of the two one-thread rows. "
             "Per run (one pinned worker's time over the two's right after it): "
-            f"{', '.join(f'{a / b:.2f}' for a, b in zip(pin_1, pin_2))}; median "
-            f"{float(np.median(np.divide(pin_1, pin_2))):.2f}×; the two workers' CPU / "
+            f"{', '.join(f'{r:.2f}' for r in per_run['pinned'])}; median "
+            f"{float(np.median(per_run['pinned'])):.2f}×; the two workers' CPU / "
             f"wall per run: {', '.join(f'{c:.2f}' for c in pin_cpu2)}. The later worker's first "
             "match began "
             f"{', '.join(f'{1e6 * x:.0f}' for x in pin_lates)} µs after the first's. "
@@ -1554,13 +1564,13 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             *pin_rows,
             "",
             "Per run (one thread's time over the two threads' time right after it): "
-            f"{', '.join(f'{a / b:.2f}' for a, b in zip(singles, doubles))}; median "
-            f"{float(np.median(np.divide(singles, doubles))):.2f}×. Two threads' CPU / wall "
+            f"{', '.join(f'{r:.2f}' for r in per_run['unpinned'])}; median "
+            f"{float(np.median(per_run['unpinned'])):.2f}×. Two threads' CPU / wall "
             f"per run: {', '.join(f'{c:.2f}' for c in cpu2)}. The second thread's first "
             "match began "
             f"{', '.join(f'{1e3 * x:.1f}' for x in lates)} ms after the clock started (a "
-            "new thread waits for the GIL, which the first one takes back between its "
-            "matches); both threads were matching during "
+            "new thread needs the GIL, and the busy first thread that hands it over may "
+            "get it woken on its own vCPU: see the pinned rows); both threads were matching during "
             f"{', '.join(f'{100 * x:.0f}' for x in overlaps)} % of the run (the rest: one "
             "thread started late or finished early).",
             "",
@@ -1578,20 +1588,19 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             "thread, so the GIL is held for a fraction of a per cent of the time), all on "
             "one thread against half on each of two: speed-up "
             f"{bundle_ratio:.2f}× (median; runs "
-            f"{', '.join(f'{a / b:.2f}' for a, b in zip(bundle_1, bundle_2))}). The ratio "
+            f"{', '.join(f'{r:.2f}' for r in per_run['bundles'])}). The ratio "
             "the two threads of single scans can reach on these cores in this run; below "
             "it, the cost is the GIL's (held for the argument conversion, the result and "
-            "the Python loop, a few µs per match).",
+            "the Python loop, a few µs per match) and that of waking a thread that waits "
+            "for it.",
             *pin_text,
         ]
     )
     if args.plot_threads:
         plot_threads(
             {
-                "unpinned": list(np.divide(singles, doubles)),
-                "pinned": list(np.divide(pin_1, pin_2)),
+                **per_run,
                 "sha": controls,
-                "bundles": list(np.divide(bundle_1, bundle_2)),
                 "late_unpinned": lates,
                 "late_pinned": pin_lates,
             },
