@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Any, TypedDict, Unpack
 
 import numpy as np
 import numpy.typing as npt
@@ -16,6 +16,33 @@ FORMAT_VERSION: int
 ArrayLike = npt.ArrayLike
 F64Array = npt.NDArray[np.float64]
 I64Array = npt.NDArray[np.int64]
+
+class _MatchOptions(TypedDict, total=False):
+    """The keyword options of :meth:`NdtGrid.match`, as :meth:`NdtGrid.match_many`
+    takes them (see :meth:`NdtGrid.match` for each one's meaning and default); for
+    type checkers only, it does not exist at run time."""
+
+    expansion: float
+    sigma_floor: float
+    shape_cell: float
+    neighbor_search: bool
+    fuse_minority: bool
+    pair_neighbors: bool
+    search_radius: int
+    max_iterations: int
+    translation_tolerance: float
+    rotation_tolerance: float
+    max_step_cells: float
+    max_step_rotation: float
+    rotation_search: float
+    rotation_gate: float
+    freeze_unconstrained: bool
+    freeze_ratio: float
+    levels: int | None
+    skip_levels: Sequence[int] | None
+    coarse_model: bool
+    expansion_phases: Sequence[float] | None
+    parallel: bool
 
 class MatchResult:
     """Outcome of :meth:`NdtGrid.match`; frozen.
@@ -316,6 +343,60 @@ class NdtGrid:
         TypeError, ValueError
             As for :meth:`insert`; also for an empty scan, a guess that is not 3
             finite values, or an option out of range.
+        """
+    def match_many(
+        self,
+        scans: Sequence[ArrayLike],
+        guesses: ArrayLike,
+        *,
+        threads: int | None = None,
+        **options: Unpack[_MatchOptions],
+    ) -> list[MatchResult]:
+        """Match many scans against the map, each from its guess, on several threads.
+
+        ``grid.match_many(scans, guesses, **options)[i]`` is, bit for bit,
+        ``grid.match(scans[i], guesses[i], **options)``, whatever the number of
+        threads: each scan is matched by one thread from start to end, and the
+        scans only read the map. The GIL is released once for the whole batch
+        and the scans are handed out one by one to whichever thread is free, so
+        one call keeps every core busy with no Python threads of the caller's:
+        relocalisation from several hypotheses, loop-closure candidates, a log
+        matched again against a finished map. Like :meth:`match`, it runs
+        beside other readers of the map and waits for an :meth:`insert` to
+        finish.
+
+        Parameters
+        ----------
+        scans : sequence of array_like, shape (N_i, 2)
+            Scan-frame points [m] of each scan, N_i >= 1 (a list of arrays, or
+            one array of shape (K, N, 2)).
+        guesses : array_like, shape (K, 3)
+            Initial pose ``[x, y, theta]`` (m, m, rad) of each scan, one row per
+            scan.
+        threads : int, optional
+            ``None`` (default): rayon's pool, one thread per core
+            (``RAYON_NUM_THREADS`` limits it); 1: one scan after the other on
+            the calling thread (with the GIL released); n: a pool of n threads
+            started for this call.
+        **options
+            Any keyword option of :meth:`match`, with the same default.
+
+        Returns
+        -------
+        list of MatchResult
+            In the order of ``scans``; empty for an empty batch.
+
+        Raises
+        ------
+        TypeError
+            If ``scans`` is not a sequence of arrays (one ``(N, 2)`` array is one
+            scan: use :meth:`match`), an option is not one of :meth:`match`'s or
+            has the wrong type.
+        ValueError
+            On a number of guesses other than one per scan, ``threads < 1``, an
+            option out of range, or a scan :meth:`match` would reject: the
+            message names the first such scan (``"scan 3: points: ..."``). The
+            inputs are checked before any scan is matched.
         """
     def evaluate(
         self,

@@ -24,7 +24,8 @@
 //! 2 cm grid takes every third scan; then, `reps` times, the 3000 scans are
 //! matched from their poses moved by a fixed offset on one thread, then
 //! split alternately between two threads on that one grid, then likewise on
-//! two clones of it; prints each run's matches per second, the ratios, and
+//! two clones of it, then by `NdtGrid::match_many` on one thread and on
+//! every core; prints each run's matches per second, the ratios, and
 //! whether the poses were the same.
 
 use std::collections::VecDeque;
@@ -291,17 +292,31 @@ fn threads(scans: &[Scan], reps: usize) -> Result<(), Box<dyn Error>> {
         }
         Ok((rate, poses))
     };
+    let points: Vec<&[[f64; 2]]> = jobs.iter().map(|(p, _)| p.as_slice()).collect();
+    let guesses: Vec<Pose2> = jobs.iter().map(|(_, g)| g.compose(offset)).collect();
+    let many = |threads: Option<usize>| -> Result<(f64, Vec<Pose2>), String> {
+        let t = Instant::now();
+        let res = grid
+            .match_many(&points, &guesses, &options, None, threads)
+            .map_err(|e| e.to_string())?;
+        let rate = jobs.len() as f64 / t.elapsed().as_secs_f64();
+        Ok((rate, res.iter().map(|m| m.pose).collect()))
+    };
     run([&grid, &grid], false)?; // distributions built, caches warm
     let clone = grid.clone();
     for _ in 0..reps {
         let (one, p1) = run([&grid, &grid], false)?;
         let (shared, p2) = run([&grid, &grid], true)?;
         let (clones, p3) = run([&grid, &clone], true)?;
+        let (many_one, p4) = many(Some(1))?;
+        let (many_all, p5) = many(None)?;
         println!(
-            "one {one:.0}/s, two on one grid {shared:.0}/s ({:.2}x), two on clones {clones:.0}/s ({:.2}x), same poses {}",
+            "one {one:.0}/s, two on one grid {shared:.0}/s ({:.2}x), two on clones {clones:.0}/s ({:.2}x), \
+             match_many one thread {many_one:.0}/s, every core {many_all:.0}/s ({:.2}x), same poses {}",
             shared / one,
             clones / one,
-            p1 == p2 && p1 == p3
+            many_all / many_one,
+            p1 == p2 && p1 == p3 && p1 == p4 && p1 == p5
         );
     }
     Ok(())

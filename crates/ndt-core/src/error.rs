@@ -203,6 +203,32 @@ pub enum NdtError {
         /// Batches of scans lost.
         batches: usize,
     },
+    /// A batch of scans ([`crate::NdtGrid::match_many`]) with a number of
+    /// guesses other than one per scan.
+    #[error("guesses: expected {expected} poses (one per scan), got {got}")]
+    GuessCount {
+        /// The number of scans.
+        expected: usize,
+        /// The number of guesses.
+        got: usize,
+    },
+    /// An error about scan `index` of a batch ([`crate::NdtGrid::match_many`]).
+    #[error("scan {index}: {error}")]
+    InScan {
+        /// Position of the scan in the batch.
+        index: usize,
+        /// What is wrong with it.
+        error: Box<NdtError>,
+    },
+    /// The threads of a batch could not be started (the operating system
+    /// refused them).
+    #[error("threads: cannot start a pool of {threads} threads: {reason}")]
+    ThreadPool {
+        /// The number of threads asked for.
+        threads: usize,
+        /// What rayon said.
+        reason: String,
+    },
     /// An output that would be larger than the stated limit.
     #[error("{what}: {size} would exceed the limit of {limit}")]
     TooLarge {

@@ -33,6 +33,7 @@ pub mod grid;
 pub mod information;
 pub mod key;
 pub mod lanexp;
+mod many;
 pub mod mapper;
 pub mod mapworker;
 pub mod matcher;

@@ -666,6 +666,28 @@ fn stack_terms(
     total
 }
 
+/// The error of an empty `expansion_phases`.
+const NO_PHASES: NdtError = NdtError::InvalidOption {
+    name: "expansion_phases",
+    expected: "at least one expansion",
+    value: 0.0,
+};
+
+/// Rejects phases [`NdtGrid::match_phased`] cannot solve with: none, or an
+/// expansion `options` cannot take.
+pub(crate) fn check_phases(options: &MatchOptions, phases: &[f64]) -> Result<()> {
+    if phases.is_empty() {
+        return Err(NO_PHASES);
+    }
+    phases.iter().try_for_each(|&expansion| {
+        MatchOptions {
+            expansion,
+            ..*options
+        }
+        .validate()
+    })
+}
+
 /// The score terms with derivatives of every level of `stack` at `pose`
 /// (from the memo where computed there before).
 fn exact_terms(
@@ -692,35 +714,8 @@ impl NdtGrid {
         options: &MatchOptions,
     ) -> Result<MatchResult> {
         options.validate()?;
-        check_finite("guess", &guess.to_array())?;
-        if points.is_empty() {
-            return Err(NdtError::Empty { what: "points" });
-        }
-        check_points("points", points)?;
-        let limit = self.coordinate_limit();
-        if let Some(index) = points
-            .iter()
-            .position(|p| p[0].abs() >= limit || p[1].abs() >= limit)
-        {
-            return Err(NdtError::CellIndexOverflow {
-                what: "points",
-                index,
-                x: points[index][0],
-                y: points[index][1],
-                limit,
-            });
-        }
-        let levels = match options.levels {
-            Some(l) => l as usize,
-            None => levels_up_to(self.cell_size(), AUTO_COARSEST_CELL, self.levels()),
-        };
-        if levels == 0 || levels > self.levels() {
-            return Err(NdtError::InvalidOption {
-                name: "levels",
-                expected: "between 1 and the grid's number of pyramid levels",
-                value: levels as f64,
-            });
-        }
+        self.check_scan(points, guess)?;
+        let levels = self.match_levels(options)?;
         // The scan's RMS radius: the lever arm that makes rotation comparable
         // with translation in the degeneracy analysis.
         let lever = (points
@@ -869,6 +864,50 @@ impl NdtGrid {
         })
     }
 
+    /// Rejects what [`NdtGrid::match_scan`] cannot match, whatever the
+    /// options: a non-finite guess, no points, a non-finite point, a point
+    /// beyond [`NdtGrid::coordinate_limit`].
+    pub(crate) fn check_scan(&self, points: &[[f64; 2]], guess: Pose2) -> Result<()> {
+        check_finite("guess", &guess.to_array())?;
+        if points.is_empty() {
+            return Err(NdtError::Empty { what: "points" });
+        }
+        check_points("points", points)?;
+        let limit = self.coordinate_limit();
+        match points
+            .iter()
+            .position(|p| p[0].abs() >= limit || p[1].abs() >= limit)
+        {
+            Some(index) => Err(NdtError::CellIndexOverflow {
+                what: "points",
+                index,
+                x: points[index][0],
+                y: points[index][1],
+                limit,
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// The pyramid levels a match with `options` passes over (fine level
+    /// included): [`MatchOptions::levels`], or by default as many as keep
+    /// the coarsest cell at most [`AUTO_COARSEST_CELL`]; an error when the
+    /// grid has fewer.
+    pub(crate) fn match_levels(&self, options: &MatchOptions) -> Result<usize> {
+        let levels = match options.levels {
+            Some(l) => l as usize,
+            None => levels_up_to(self.cell_size(), AUTO_COARSEST_CELL, self.levels()),
+        };
+        if levels == 0 || levels > self.levels() {
+            return Err(NdtError::InvalidOption {
+                name: "levels",
+                expected: "between 1 and the grid's number of pyramid levels",
+                value: levels as f64,
+            });
+        }
+        Ok(levels)
+    }
+
     /// The phased adjustment of the authors' earlier paper (Kaminade et al.,
     /// ICRA 2008; §IV-B of this one): solve with each expansion `k` of
     /// `phases` in turn (e.g. 100, 10, 1), each from the previous result.
@@ -880,9 +919,7 @@ impl NdtGrid {
         options: &MatchOptions,
         phases: &[f64],
     ) -> Result<MatchResult> {
-        if phases.is_empty() {
-            return Err(NdtError::Empty { what: "expansion" });
-        }
+        check_phases(options, phases)?;
         let mut pose = guess;
         let mut iterations = 0;
         let mut last = None;
@@ -896,7 +933,7 @@ impl NdtGrid {
             pose = res.pose;
             last = Some(res);
         }
-        let mut res = last.ok_or(NdtError::Empty { what: "expansion" })?;
+        let mut res = last.ok_or(NO_PHASES)?;
         res.iterations = iterations;
         Ok(res)
     }

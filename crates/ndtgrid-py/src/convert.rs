@@ -29,7 +29,7 @@ impl Points<'_> {
     }
 }
 
-fn shape_text(shape: &[usize]) -> String {
+pub fn shape_text(shape: &[usize]) -> String {
     match shape {
         [n] => format!("({n},)"),
         _ => format!(
@@ -161,6 +161,30 @@ pub fn pose(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 3]> {
             "{what}: expected 3 values [x, y, theta]"
         ))),
     }
+}
+
+/// Validates and copies `(K, 3)` poses `[x, y, theta]` named `what` (an
+/// empty sequence is no pose).
+pub fn poses(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f64; 3]>> {
+    let arr = real_array(obj, what)?;
+    let shape = arr.shape();
+    if shape == [0] {
+        return Ok(Vec::new());
+    }
+    if shape.len() != 2 || shape[1] != 3 {
+        return Err(PyValueError::new_err(format!(
+            "{what}: expected an array of shape (K, 3), one [x, y, theta] per row, got shape {}",
+            shape_text(shape)
+        )));
+    }
+    let arr = as_f64_contiguous(arr)?
+        .cast_into::<PyArray2<f64>>()
+        .map_err(|e| PyTypeError::new_err(format!("{what}: {e}")))?;
+    // Copied while the GIL is held: no borrow of the array to track.
+    let flat = arr
+        .to_vec()
+        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
+    Ok(flat.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect())
 }
 
 /// A `(3,)` float64 array.

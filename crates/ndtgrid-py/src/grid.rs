@@ -9,12 +9,14 @@ use std::path::PathBuf;
 use std::sync::{Arc, RwLock};
 
 use ndt_core::{MatchOptions, NdtGrid, Pose2};
-use numpy::{PyArray1, PyArray2, PyArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyType};
 
-use crate::convert::{count, level_mask, level_tuple, mat3, points, pose, rows, vec3};
+use crate::convert::{count, level_mask, mat3, points, pose, poses, rows, shape_text, vec3};
 use crate::errors::{poisoned, to_py};
+use crate::match_options::options_from_kwargs;
 use crate::result::PyMatchResult;
 
 /// `(score, gradient, hessian, num_matched)` as returned by `evaluate`.
@@ -205,6 +207,58 @@ impl PyNdtGrid {
         .map_err(to_py)
     }
 
+    /// Matches many scans, each from its guess, spread over threads (see the stub).
+    #[pyo3(signature = (scans, guesses, *, threads = None, **options))]
+    fn match_many(
+        &self,
+        py: Python<'_>,
+        scans: &Bound<'_, PyAny>,
+        guesses: &Bound<'_, PyAny>,
+        threads: Option<i64>,
+        options: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Vec<PyMatchResult>> {
+        let (options, phases) = options_from_kwargs("match_many", options)?;
+        let threads = threads
+            .map(|t| count("threads", t).map(|t| t as usize))
+            .transpose()?;
+        if let Ok(one) = scans.cast::<PyUntypedArray>() {
+            if one.ndim() < 3 {
+                return Err(PyTypeError::new_err(format!(
+                    "scans: expected a sequence of (N, 2) arrays, got one array of shape {} \
+                     (one scan: use match)",
+                    shape_text(one.shape())
+                )));
+            }
+        }
+        let items = scans.try_iter().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "scans: expected a sequence of (N, 2) arrays, got {}",
+                scans
+                    .get_type()
+                    .name()
+                    .map(|n| n.to_string())
+                    .unwrap_or_default()
+            ))
+        })?;
+        let arrays = items
+            .enumerate()
+            .map(|(i, item)| points(&item?, &format!("scan {i}: points")))
+            .collect::<PyResult<Vec<_>>>()?;
+        let pairs = arrays
+            .iter()
+            .map(|a| a.as_pairs())
+            .collect::<PyResult<Vec<_>>>()?;
+        let guesses: Vec<Pose2> = poses(guesses, "guesses")?
+            .into_iter()
+            .map(|[x, y, theta]| Pose2 { x, y, theta })
+            .collect();
+        self.read(py, |grid| {
+            grid.match_many(&pairs, &guesses, &options, phases.as_deref(), threads)
+        })?
+        .map(|results| results.into_iter().map(PyMatchResult::from).collect())
+        .map_err(to_py)
+    }
+
     /// Score terms of eq. (1) at `pose` without solving.
     #[pyo3(signature = (
         points, pose, *, expansion = 10.0, sigma_floor = 0.02, shape_cell = 0.32, neighbor_search = true, fuse_minority = true,
@@ -344,52 +398,4 @@ pub(crate) type Reduced<'py> = (Bound<'py, PyAny>, (Bound<'py, PyBytes>,));
 
 fn points_arg<'py>(obj: &Bound<'py, PyAny>) -> PyResult<crate::convert::Points<'py>> {
     points(obj, "points")
-}
-
-/// The core's default match options, so the Python layer and its tests can
-/// check that the documented defaults are the ones in force.
-#[pyfunction]
-pub fn default_match_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
-    options_dict(py, &MatchOptions::default())
-}
-
-/// The core's options of the paper's method alone (`MatchOptions::paper`)
-/// and of the original NDT (`MatchOptions::original_ndt`), so that the
-/// Python presets can be checked against them.
-#[pyfunction]
-pub fn preset_match_options<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>> {
-    match name {
-        "paper" => options_dict(py, &MatchOptions::paper()),
-        "original_ndt" => options_dict(py, &MatchOptions::original_ndt()),
-        _ => Err(pyo3::exceptions::PyValueError::new_err(format!(
-            "name: expected 'paper' or 'original_ndt', got {name:?}"
-        ))),
-    }
-}
-
-/// `MatchOptions` as `match` keyword arguments.
-fn options_dict<'py>(py: Python<'py>, d: &MatchOptions) -> PyResult<Bound<'py, PyDict>> {
-    let out = PyDict::new(py);
-    out.set_item("expansion", d.expansion)?;
-    out.set_item("sigma_floor", d.sigma_floor)?;
-    out.set_item("shape_cell", d.shape_cell)?;
-    out.set_item("neighbor_search", d.neighbor_search)?;
-    out.set_item("fuse_minority", d.fuse_minority)?;
-    out.set_item("pair_neighbors", d.pair_neighbors)?;
-    out.set_item("search_radius", d.search_radius)?;
-    out.set_item("max_iterations", d.max_iterations)?;
-    out.set_item("translation_tolerance", d.translation_tolerance)?;
-    out.set_item("rotation_tolerance", d.rotation_tolerance)?;
-    out.set_item("max_step_cells", d.max_step_cells)?;
-    out.set_item("max_step_rotation", d.max_step_rotation)?;
-    out.set_item("rotation_search", d.rotation_search)?;
-    out.set_item("rotation_gate", d.rotation_gate)?;
-    out.set_item("freeze_unconstrained", d.freeze_unconstrained)?;
-    out.set_item("freeze_ratio", d.freeze_ratio)?;
-    out.set_item("levels", d.levels)?;
-    out.set_item("skip_levels", level_tuple(py, d.skip_levels)?)?;
-    out.set_item("coarse_model", d.coarse_model)?;
-    out.set_item("expansion_phases", py.None())?;
-    out.set_item("parallel", d.parallel)?;
-    Ok(out)
 }

@@ -8,6 +8,7 @@ mod freespace;
 mod grid;
 mod mapper;
 mod mapper_options;
+mod match_options;
 mod odometry;
 mod ranges;
 mod result;
@@ -32,8 +33,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<odometry::PyStep>()?;
     m.add_class::<freespace::PyFreeSpace>()?;
     m.add_function(wrap_pyfunction!(odometry::default_odometry_config, m)?)?;
-    m.add_function(wrap_pyfunction!(grid::default_match_options, m)?)?;
-    m.add_function(wrap_pyfunction!(grid::preset_match_options, m)?)?;
+    m.add_function(wrap_pyfunction!(match_options::default_match_options, m)?)?;
+    m.add_function(wrap_pyfunction!(match_options::preset_match_options, m)?)?;
     m.add_function(wrap_pyfunction!(ranges::ranges_to_points, m)?)?;
     m.add_function(wrap_pyfunction!(se2::compose, m)?)?;
     m.add_function(wrap_pyfunction!(se2::inverse, m)?)?;

@@ -1,0 +1,259 @@
+//! Many scans matched against one grid in one call ([`NdtGrid::match_many`]):
+//! relocalisation from several hypotheses, loop-closure candidates, a log
+//! re-matched against a finished map. Each scan's result is that of its own
+//! [`NdtGrid::match_scan`] (or [`NdtGrid::match_phased`]) call, bit for bit,
+//! whatever the number of threads: a scan is matched by one thread from
+//! start to end, and the scans share nothing but the grid, which they only
+//! read.
+//!
+//! The scans are spread over a rayon pool, which hands them out one by one
+//! to whichever thread is free (a slower core simply takes fewer), so one
+//! call keeps every core busy without a thread per scan or per core on the
+//! caller's side.
+
+use rayon::prelude::*;
+
+use crate::error::{NdtError, Result};
+use crate::grid::NdtGrid;
+use crate::matcher::{check_phases, MatchOptions, MatchResult};
+use crate::se2::Pose2;
+
+impl NdtGrid {
+    /// Matches `scans[i]` (scan-frame points \[m\]) from `guesses[i]`
+    /// (`T_map_scan`) for every `i`, with `options`, or with the phased
+    /// expansions `phases` when given ([`NdtGrid::match_phased`]); results
+    /// in the order of the scans.
+    ///
+    /// `threads`: `None` spreads the scans over rayon's global pool (every
+    /// core; `RAYON_NUM_THREADS` limits it), `Some(1)` matches them one
+    /// after the other on the calling thread, `Some(n)` on a pool of `n`
+    /// threads started for this call.
+    ///
+    /// Everything is checked before any scan is matched: the options, the
+    /// number of guesses, and each scan as [`NdtGrid::match_scan`] checks
+    /// it ([`NdtError::InScan`] names the first scan rejected). An empty
+    /// batch gives an empty result.
+    pub fn match_many(
+        &self,
+        scans: &[&[[f64; 2]]],
+        guesses: &[Pose2],
+        options: &MatchOptions,
+        phases: Option<&[f64]>,
+        threads: Option<usize>,
+    ) -> Result<Vec<MatchResult>> {
+        options.validate()?;
+        if let Some(phases) = phases {
+            check_phases(options, phases)?;
+        }
+        self.match_levels(options)?;
+        if threads == Some(0) {
+            return Err(NdtError::InvalidOption {
+                name: "threads",
+                expected: "at least 1 thread (or None: every core)",
+                value: 0.0,
+            });
+        }
+        if guesses.len() != scans.len() {
+            return Err(NdtError::GuessCount {
+                expected: scans.len(),
+                got: guesses.len(),
+            });
+        }
+        let in_scan = |index: usize| {
+            move |error: NdtError| NdtError::InScan {
+                index,
+                error: Box::new(error),
+            }
+        };
+        for (index, (points, guess)) in scans.iter().zip(guesses).enumerate() {
+            self.check_scan(points, *guess).map_err(in_scan(index))?;
+        }
+        let one = |(points, guess): (&&[[f64; 2]], &Pose2)| match phases {
+            Some(phases) => self.match_phased(points, *guess, options, phases),
+            None => self.match_scan(points, *guess, options),
+        };
+        let results: Vec<Result<MatchResult>> = match threads {
+            Some(1) => scans.iter().zip(guesses).map(one).collect(),
+            None => scans.par_iter().zip(guesses).map(one).collect(),
+            Some(n) => rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| NdtError::ThreadPool {
+                    threads: n,
+                    reason: e.to_string(),
+                })?
+                .install(|| scans.par_iter().zip(guesses).map(one).collect()),
+        };
+        // Nothing fails once the inputs are checked; should a scan still
+        // fail, the first one's error is the call's.
+        results
+            .into_iter()
+            .enumerate()
+            .map(|(index, r)| r.map_err(in_scan(index)))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    /// A room's walls (4 × 3 m, a box inside) seen from `pose`: scan-frame points.
+    fn room_scan(pose: Pose2, rng: &mut StdRng) -> Vec<[f64; 2]> {
+        let mut world = Vec::new();
+        for i in 0..400 {
+            let t = f64::from(i) / 400.0;
+            world.push([-2.0 + 4.0 * t, -1.5]);
+            world.push([-2.0 + 4.0 * t, 1.5]);
+            world.push([-2.0, -1.5 + 3.0 * t]);
+            world.push([2.0, -1.5 + 3.0 * t]);
+            world.push([0.5 + 0.3 * t, 0.2]);
+        }
+        let (s, c) = pose.theta.sin_cos();
+        world
+            .iter()
+            .filter(|_| rng.random_range(0.0..1.0) < 0.35)
+            .map(|p| {
+                let (dx, dy) = (p[0] - pose.x, p[1] - pose.y);
+                [c * dx + s * dy, -s * dx + c * dy]
+            })
+            .collect()
+    }
+
+    fn batch(n: usize) -> (NdtGrid, Vec<Vec<[f64; 2]>>, Vec<Pose2>) {
+        let mut rng = StdRng::seed_from_u64(5);
+        let mut grid = NdtGrid::new(0.02).unwrap();
+        for k in 0..6 {
+            let at = Pose2::new(
+                0.1 * f64::from(k),
+                -0.05 * f64::from(k),
+                0.02 * f64::from(k),
+            );
+            grid.insert(&room_scan(at, &mut rng), at).unwrap();
+        }
+        let mut scans = Vec::new();
+        let mut guesses = Vec::new();
+        for i in 0..n {
+            let truth = Pose2::new(
+                rng.random_range(-0.3..0.3),
+                rng.random_range(-0.3..0.3),
+                rng.random_range(-0.1..0.1),
+            );
+            scans.push(room_scan(truth, &mut rng));
+            let off = 0.02 + 0.01 * (i % 3) as f64;
+            guesses.push(Pose2::new(truth.x + off, truth.y - off, truth.theta + 0.01));
+        }
+        (grid, scans, guesses)
+    }
+
+    fn views(scans: &[Vec<[f64; 2]>]) -> Vec<&[[f64; 2]]> {
+        scans.iter().map(Vec::as_slice).collect()
+    }
+
+    /// One thread, the global pool and a pool of three give each scan the
+    /// bits of its own `match_scan` (and `match_phased`) call, in order.
+    #[test]
+    fn same_bits_as_one_call_per_scan() {
+        let (grid, scans, guesses) = batch(23);
+        let options = MatchOptions::default();
+        for phases in [None, Some([100.0, 10.0].as_slice())] {
+            let want: Vec<MatchResult> = scans
+                .iter()
+                .zip(&guesses)
+                .map(|(s, g)| match phases {
+                    Some(p) => grid.match_phased(s, *g, &options, p).unwrap(),
+                    None => grid.match_scan(s, *g, &options).unwrap(),
+                })
+                .collect();
+            assert!(want.iter().all(|r| r.converged));
+            for threads in [Some(1), None, Some(3)] {
+                let got = grid
+                    .match_many(&views(&scans), &guesses, &options, phases, threads)
+                    .unwrap();
+                assert_eq!(got, want, "threads {threads:?}, phases {phases:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn empty_batch_gives_nothing() {
+        let (grid, _, _) = batch(0);
+        let got = grid
+            .match_many(&[], &[], &MatchOptions::default(), None, None)
+            .unwrap();
+        assert!(got.is_empty());
+    }
+
+    /// Bad input is refused before any scan is matched, with the first bad
+    /// scan's index and the message `match_scan` gives for it.
+    #[test]
+    fn errors_name_the_scan() {
+        let (grid, mut scans, mut guesses) = batch(4);
+        let options = MatchOptions::default();
+        let run = |scans: &[Vec<[f64; 2]>], guesses: &[Pose2], threads| {
+            grid.match_many(&views(scans), guesses, &options, None, threads)
+                .unwrap_err()
+                .to_string()
+        };
+        assert_eq!(
+            run(&scans, &guesses[..3], None),
+            "guesses: expected 4 poses (one per scan), got 3"
+        );
+        assert_eq!(
+            run(&scans, &guesses, Some(0)),
+            "threads: expected at least 1 thread (or None: every core), got 0"
+        );
+        scans[2][7] = [f64::NAN, 0.0];
+        scans[3].clear();
+        assert_eq!(
+            run(&scans, &guesses, None),
+            "scan 2: points: expected finite values, got NaN at index 7"
+        );
+        scans[2][7] = [0.0, 0.0];
+        assert_eq!(
+            run(&scans, &guesses, None),
+            "scan 3: points: expected at least one point, got 0"
+        );
+        scans[3].push([0.0, 0.0]);
+        guesses[1].theta = f64::INFINITY;
+        assert_eq!(
+            run(&scans, &guesses, None),
+            "scan 1: guess: expected finite values, got inf at index 2"
+        );
+        guesses[1].theta = 0.0;
+        let bad = MatchOptions {
+            levels: Some(9),
+            ..options
+        };
+        let err = grid
+            .match_many(&views(&scans), &guesses, &bad, None, None)
+            .unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "levels: expected between 1 and the grid's number of pyramid levels, got 9"
+        );
+        let err = grid
+            .match_many(
+                &views(&scans),
+                &guesses,
+                &options,
+                Some(&[10.0, -1.0]),
+                None,
+            )
+            .unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "expansion: expected a finite value > 0, got -1"
+        );
+        let err = grid
+            .match_many(&views(&scans), &guesses, &options, Some(&[]), None)
+            .unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "expansion_phases: expected at least one expansion, got 0"
+        );
+    }
+}
