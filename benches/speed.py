@@ -30,7 +30,8 @@ as a Markdown table to stdout as soon as it is measured (progress goes to stderr
 5. **Threads**: matches per second of two Python threads matching different scans
    against one grid, against one thread, twice: threads started for each run where the
    kernel puts them, and two long-lived worker threads pinned to the two cores
-   (``benches/pinned.py``); two GIL-free controls in the same run (SHA-256, and our
+   (``benches/pinned.py``); the same scans in one ``NdtGrid.match_many`` call on one
+   thread and on every core; two GIL-free controls in the same run (SHA-256, and our
    matcher on bundles of 20 scans merged into one, whose calls are long enough that the
    GIL hardly matters); each run's ratios and late starts in
    ``docs/img/speed_threads.png`` when matplotlib is installed.
@@ -1289,7 +1290,8 @@ def plot_sweeps(res: dict[str, Any], path: Path) -> None:
 def plot_threads(runs: dict[str, list[float]], path: Path) -> None:
     """The thread section's runs as a PNG (skipped without matplotlib): each run's
     ratio (one thread's time over two threads' right after it) for the unpinned and
-    pinned threads and the two GIL-free controls; when the later thread began."""
+    pinned threads, ``match_many`` and the two GIL-free controls; when the later thread
+    began."""
     plt = pyplot()
     if plt is None:
         return
@@ -1299,6 +1301,7 @@ def plot_threads(runs: dict[str, list[float]], path: Path) -> None:
         ("pinned", "s", "two pinned workers"),
         ("sha", "x", "control: SHA-256 (GIL released)"),
         ("bundles", "+", "control: 20-scan bundles"),
+        ("many", "D", "match_many, every core / one thread"),
     ):
         ys = runs.get(key, [])
         if ys:
@@ -1460,16 +1463,31 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         wall = max(sp[1] for sp in spans) - t0
         return wall, max(sp[0] for sp in spans) - t0, sum(cpu) / wall
 
+    # The same scans in one `match_many` call: on the calling thread, then on rayon's
+    # pool (every core); the GIL released once for the batch.
+    many_scans = [p for p, _ in jobs]
+    many_guesses = np.array([g for _, g in jobs])
+
+    def many(threads: int | None) -> tuple[float, float, list[F64]]:
+        """Wall time, this process's CPU time over it, and the poses."""
+        with no_gc():
+            c0, t0 = time.process_time(), time.perf_counter()
+            res = grid.match_many(many_scans, many_guesses, threads=threads)
+            dt = time.perf_counter() - t0
+            return dt, (time.process_time() - c0) / dt, [r.pose for r in res]
+
     load = os.getloadavg()
     controls = []
     singles, doubles, cpu1, cpu2 = [], [], [], []
     lates, overlaps = [], []
     bundle_1, bundle_2 = [], []
     pin_1, pin_2, pin_lates, pin_cpu1, pin_cpu2 = [], [], [], [], []
+    many_1, many_2, many_cpu = [], [], []
     same = True
     try:
         for rep in progress(range(args.thread_reps), "threads"):
             t1, c1, r1 = one()
+            base = r1
             t2, c2, r2, late, overlap = two()
             singles.append(t1)
             doubles.append(t2)
@@ -1497,6 +1515,12 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
                 pin_2.append(t2)
                 pin_lates.append(late)
                 same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
+            t1, c1, r1 = many(1)
+            t2, c2, r2 = many(None)
+            many_1.append(t1)
+            many_2.append(t2)
+            many_cpu.append(c2)
+            same &= all(np.array_equal(a, b) for a, b in zip(base + base, r1 + r2))
     finally:
         if workers is not None:
             workers.close()
@@ -1509,7 +1533,12 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "unpinned": list(np.divide(singles, doubles)),
         "pinned": list(np.divide(pin_1, pin_2)),
         "bundles": list(np.divide(bundle_1, bundle_2)),
+        "many": list(np.divide(many_1, many_2)),
     }
+    # match_many against the faster one-thread baseline too (its own, and the loop's).
+    mm1, mm2 = n / np.median(many_1), n / np.median(many_2)
+    mb1, mb2 = n / min(many_1), n / min(many_2)
+    many_ratio, many_best = mm2 / max(mm1, s1), mb2 / max(mb1, b1)
     if pin_1 and cpus is not None:
         # Judged against the faster of the two one-thread baselines (pinned, cores in
         # turn; unpinned, where the kernel put it), so that a slow core alone cannot
@@ -1562,6 +1591,11 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             f"| 2 | {s2:.0f} | {b2:.0f} | {np.median(cpu2):.2f} |",
             f"| ratio | {s2 / s1:.2f}× | {b2 / b1:.2f}× | |",
             *pin_rows,
+            f"| `match_many`, one thread (`threads=1`) | {mm1:.0f} | {mb1:.0f} | |",
+            f"| `match_many`, every core (`threads=None`: rayon's pool) | {mm2:.0f} | {mb2:.0f} "
+            f"| {np.median(many_cpu):.2f} |",
+            f"| ratio, `match_many` (against the faster one-thread row) | {many_ratio:.2f}× "
+            f"| {many_best:.2f}× | |",
             "",
             "Per run (one thread's time over the two threads' time right after it): "
             f"{', '.join(f'{r:.2f}' for r in per_run['unpinned'])}; median "
@@ -1594,6 +1628,15 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             "the Python loop, a few µs per match) and that of waking a thread that waits "
             "for it.",
             *pin_text,
+            "",
+            f"`match_many`: the same {n} scans and guesses in one `NdtGrid.match_many` call "
+            "(the GIL released once for the batch; rayon hands the scans out one by one to "
+            "whichever thread is free), on the calling thread and then on rayon's pool, after "
+            "each pair of runs above; the ratio is taken against the faster of its own "
+            "one-thread row and the first row. Per run (one thread's time over every core's "
+            "right after it): "
+            f"{', '.join(f'{r:.2f}' for r in per_run['many'])}; median "
+            f"{float(np.median(per_run['many'])):.2f}×.",
         ]
     )
     if args.plot_threads:
@@ -1614,6 +1657,8 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "load": load[0],
         "control": float(np.median(controls)),
         "bundle_ratio": bundle_ratio,
+        "many_ratio": many_ratio,
+        "many_ratio_best": many_best,
     }
 
 
@@ -1817,6 +1862,12 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
             if math.isnan(pr)
             else f"{pr:.2f}× (best runs {t['pinned_ratio_best']:.2f}×)",
             None if math.isnan(pr) else pr >= 1.7,
+        )
+        row(
+            "one `match_many` call on every core ≥ 1.7× one thread (the library's own "
+            "threads, not Python's)",
+            f"{t['many_ratio']:.2f}× (best runs {t['many_ratio_best']:.2f}×)",
+            t["many_ratio"] >= 1.7,
         )
     mem = res.get("memory", {})
     if mem:
