@@ -1463,8 +1463,9 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         wall = max(sp[1] for sp in spans) - t0
         return wall, max(sp[0] for sp in spans) - t0, sum(cpu) / wall
 
-    # The same scans in one `match_many` call: on the calling thread, then on rayon's
-    # pool (every core); the GIL released once for the batch.
+    # The same scans in one `match_many` call: on the calling thread alone, then on
+    # every core (the calling thread and a helper started for the batch); the GIL
+    # released once for the batch.
     many_scans = [p for p, _ in jobs]
     many_guesses = np.array([g for _, g in jobs])
 
@@ -1592,7 +1593,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             f"| ratio | {s2 / s1:.2f}× | {b2 / b1:.2f}× | |",
             *pin_rows,
             f"| `match_many`, one thread (`threads=1`) | {mm1:.0f} | {mb1:.0f} | |",
-            f"| `match_many`, every core (`threads=None`: rayon's pool) | {mm2:.0f} | {mb2:.0f} "
+            f"| `match_many`, every core (`threads=None`) | {mm2:.0f} | {mb2:.0f} "
             f"| {np.median(many_cpu):.2f} |",
             f"| ratio, `match_many` (against the faster one-thread row) | {many_ratio:.2f}× "
             f"| {many_best:.2f}× | |",
@@ -1630,8 +1631,9 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             *pin_text,
             "",
             f"`match_many`: the same {n} scans and guesses in one `NdtGrid.match_many` call "
-            "(the GIL released once for the batch; rayon hands the scans out one by one to "
-            "whichever thread is free), on the calling thread and then on rayon's pool, after "
+            "(the GIL released once for the batch; the calling thread and a helper started for "
+            "the batch each take the next scan not yet taken), on the calling thread alone and "
+            "then on every core, after "
             "each pair of runs above; the ratio is taken against the faster of its own "
             "one-thread row and the first row. Per run (one thread's time over every core's "
             "right after it): "

@@ -180,6 +180,52 @@ def test_matches_while_one_thread_inserts_see_whole_states_in_order(
     assert len(reached) >= len(SCANS) // 2
 
 
+def test_match_many_while_one_thread_inserts_sees_one_state_per_batch() -> None:
+    """``match_many`` holds the read lock for its whole batch: every scan of a batch is
+    matched on the same state (bit for bit its ``ref[k]``), and a reader's states only
+    go forward."""
+    ref = states_of(insert_grid, lambda: ndtgrid.NdtGrid(0.02))
+    grid = ndtgrid.NdtGrid(0.02)
+    insert_grid(grid, 0)
+    scans = [pts for pts, _ in QUERIES]
+    guesses = np.array([g for _, g in QUERIES])
+    done = threading.Event()
+    seen: list[list[list[tuple[Any, ...]]]] = [[] for _ in range(2)]
+    errors: list[BaseException] = []
+
+    def reader(i: int) -> None:
+        try:
+            while True:
+                last_round = done.is_set()
+                batch = grid.match_many(scans, guesses, threads=1 + i)
+                seen[i].append([key(r) for r in batch])
+                if last_round:
+                    break
+        except BaseException as e:  # pragma: no cover - reported below
+            errors.append(e)
+
+    threads = [threading.Thread(target=reader, args=(i,), daemon=True) for i in range(2)]
+    for t in threads:
+        t.start()
+    for k in range(1, len(SCANS)):
+        n = results(seen)
+        wait_until(lambda n=n: results(seen) >= n + 2)
+        insert_grid(grid, k)
+    done.set()
+    for t in threads:
+        t.join(JOIN_TIMEOUT)
+    assert not any(t.is_alive() for t in threads), "a reader hung (deadlock?)"
+    assert not errors, errors
+    for i in range(2):
+        states = []
+        for batch in seen[i]:
+            same = [k for k in range(1, len(SCANS) + 1) if ref[k] == batch]
+            assert same, f"reader {i}: a batch equal to no single state"
+            states.append(same[0])
+        assert states == sorted(states), f"reader {i}: states went back: {states}"
+        assert states[-1] == len(SCANS)
+
+
 def test_mapper_shared_by_threads_neither_deadlocks_nor_crashes() -> None:
     """Two threads insert scans into one Mapper while two read it (occupied cells, small
     objects, counters, matches on its grid). Inserts are serialized: every scan counts."""

@@ -357,11 +357,12 @@ class NdtGrid:
         ``grid.match_many(scans, guesses, **options)[i]`` is, bit for bit,
         ``grid.match(scans[i], guesses[i], **options)``, whatever the number of
         threads: each scan is matched by one thread from start to end, and the
-        scans only read the map. The GIL is released once for the whole batch
-        and the scans are handed out one by one to whichever thread is free, so
-        one call keeps every core busy with no Python threads of the caller's:
-        relocalisation from several hypotheses, loop-closure candidates, a log
-        matched again against a finished map. Like :meth:`match`, it runs
+        scans only read the map. The GIL is released once for the whole batch;
+        the calling thread matches scans beside helper threads started for the
+        batch (a new thread goes to an idle core), each taking the next scan not
+        yet taken, so one call keeps every core busy with no Python threads of
+        the caller's: relocalisation from several hypotheses, loop-closure
+        candidates, a log matched again against a finished map. Like :meth:`match`, it runs
         beside other readers of the map and waits for an :meth:`insert` to
         finish.
 
@@ -374,10 +375,12 @@ class NdtGrid:
             Initial pose ``[x, y, theta]`` (m, m, rad) of each scan, one row per
             scan.
         threads : int, optional
-            ``None`` (default): rayon's pool, one thread per core
-            (``RAYON_NUM_THREADS`` limits it); 1: one scan after the other on
-            the calling thread (with the GIL released); n: a pool of n threads
-            started for this call.
+            Threads that match: the calling thread and ``threads - 1`` helpers
+            (never more than scans). ``None`` (default): one per core the
+            process may run on (``len(os.sched_getaffinity(0))`` on Linux); 1:
+            one scan after the other on the calling thread (with the GIL
+            released). A helper the system refuses to start leaves its share
+            to the others.
         **options
             Any keyword option of :meth:`match`, with the same default.
 
@@ -397,6 +400,8 @@ class NdtGrid:
             option out of range, or a scan :meth:`match` would reject: the
             message names the first such scan (``"scan 3: points: ..."``). The
             inputs are checked before any scan is matched.
+        RuntimeError
+            If a helper thread failed (an internal error).
         """
     def evaluate(
         self,

@@ -1,12 +1,14 @@
 //! `cargo bench`: insert and match of 180-, 361-, 683- and 2000-point scans
-//! on 2 cm and 20 cm grids, and the pyramid update alone (one core, one
-//! thread; throughput in scan points).
+//! on 2 cm and 20 cm grids, and the pyramid update alone (one thread unless
+//! a group's name says otherwise; throughput in scan points, in scans for
+//! `match_many`).
 //!
 //! The map is the synthetic room of the tests, built from eight scans; the
 //! matched scan is taken 3 cm / 1° away from its guess. `match` uses the
 //! default options (pyramid), `match_paper` the paper's method alone,
 //! `match_large` matches 8192-, 16384- and 32000-point scans (2 cm) with and without
-//! `MatchOptions::parallel`.
+//! `MatchOptions::parallel`; `match_many` matches 64 different 683-point
+//! scans in one call on one thread and on every core (throughput in scans).
 //! `insert` keeps the prepared distributions of a default match up to date
 //! (as in a SLAM loop), `insert_sums_only` has none prepared (eq. 6 and the
 //! pyramid's sums only), `pyramid_update` is the pyramid's part of that; both
@@ -223,12 +225,39 @@ fn bench_large(c: &mut Criterion) {
     group.finish();
 }
 
+/// 64 different 683-point scans, each 3 cm / 1° off, in one `match_many`
+/// call: on the calling thread and on rayon's pool (every core).
+fn bench_many(c: &mut Criterion) {
+    let mut group = c.benchmark_group("match_many");
+    group.sample_size(20);
+    let grid = map(683, 0.02);
+    let (scans, guesses): (Vec<_>, Vec<_>) = (0..64u32)
+        .map(|i| {
+            let a = f64::from(i) * 0.1;
+            let truth = Pose2::new(0.2 * a.cos(), 0.15 * a.sin(), a);
+            let guess = Pose2::new(truth.x + 0.03, truth.y - 0.02, truth.theta + 0.017);
+            (scan(683, truth, 100 + u64::from(i)), guess)
+        })
+        .unzip();
+    let views: Vec<&[[f64; 2]]> = scans.iter().map(Vec::as_slice).collect();
+    let options = MatchOptions::default();
+    group.throughput(Throughput::Elements(views.len() as u64));
+    for (name, threads) in [("one_thread", Some(1)), ("every_core", None)] {
+        let _ = grid.match_many(&views, &guesses, &options, None, threads);
+        group.bench_function(name, |b| {
+            b.iter(|| grid.match_many(black_box(&views), &guesses, &options, None, threads))
+        });
+    }
+    group.finish();
+}
+
 criterion_group!(
     benches,
     bench_insert,
     bench_insert_loop,
     bench_pyramid,
     bench_match,
-    bench_large
+    bench_large,
+    bench_many
 );
 criterion_main!(benches);

@@ -220,13 +220,11 @@ pub enum NdtError {
         /// What is wrong with it.
         error: Box<NdtError>,
     },
-    /// The threads of a batch could not be started (the operating system
-    /// refused them).
-    #[error("threads: cannot start a pool of {threads} threads: {reason}")]
-    ThreadPool {
-        /// The number of threads asked for.
-        threads: usize,
-        /// What rayon said.
+    /// A helper thread of a batch ([`crate::NdtGrid::match_many`]) ended in
+    /// a panic (a bug: reported rather than passed on).
+    #[error("internal error: a thread matching scans of the batch panicked: {reason}")]
+    ThreadPanicked {
+        /// The panic's message, when it has one.
         reason: String,
     },
     /// An output that would be larger than the stated limit.

@@ -6,12 +6,18 @@
 //! start to end, and the scans share nothing but the grid, which they only
 //! read.
 //!
-//! The scans are spread over a rayon pool, which hands them out one by one
-//! to whichever thread is free (a slower core simply takes fewer), so one
-//! call keeps every core busy without a thread per scan or per core on the
-//! caller's side.
+//! The calling thread matches scans too, beside helper threads started for
+//! the batch; each thread takes the next scan not yet taken (a counter), so
+//! a slower core simply takes fewer. Helpers are started per batch rather
+//! than woken from a pool: a new thread goes to the idlest core, whereas a
+//! sleeping pool thread woken by a busy one may be put on the waker's core
+//! and wait there for the scheduler's tick (seen on this project's VM with
+//! rayon's pool: BENCHMARK.md, "Speed", session 30). Starting a thread costs
+//! tens of microseconds, a 683-point match about 70.
 
-use rayon::prelude::*;
+use std::any::Any;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::thread;
 
 use crate::error::{NdtError, Result};
 use crate::grid::NdtGrid;
@@ -24,10 +30,11 @@ impl NdtGrid {
     /// expansions `phases` when given ([`NdtGrid::match_phased`]); results
     /// in the order of the scans.
     ///
-    /// `threads`: `None` spreads the scans over rayon's global pool (every
-    /// core; `RAYON_NUM_THREADS` limits it), `Some(1)` matches them one
-    /// after the other on the calling thread, `Some(n)` on a pool of `n`
-    /// threads started for this call.
+    /// `threads`: how many threads match: the calling thread and `threads −
+    /// 1` helpers (never more threads than scans). `None`: one per core the
+    /// process may run on ([`std::thread::available_parallelism`]);
+    /// `Some(1)`: the calling thread alone. A helper the system refuses to
+    /// start leaves its share to the others.
     ///
     /// Everything is checked before any scan is matched: the options, the
     /// number of guesses, and each scan as [`NdtGrid::match_scan`] checks
@@ -68,22 +75,13 @@ impl NdtGrid {
         for (index, (points, guess)) in scans.iter().zip(guesses).enumerate() {
             self.check_scan(points, *guess).map_err(in_scan(index))?;
         }
-        let one = |(points, guess): (&&[[f64; 2]], &Pose2)| match phases {
-            Some(phases) => self.match_phased(points, *guess, options, phases),
-            None => self.match_scan(points, *guess, options),
+        let one = |i: usize| match phases {
+            Some(phases) => self.match_phased(scans[i], guesses[i], options, phases),
+            None => self.match_scan(scans[i], guesses[i], options),
         };
-        let results: Vec<Result<MatchResult>> = match threads {
-            Some(1) => scans.iter().zip(guesses).map(one).collect(),
-            None => scans.par_iter().zip(guesses).map(one).collect(),
-            Some(n) => rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|e| NdtError::ThreadPool {
-                    threads: n,
-                    reason: e.to_string(),
-                })?
-                .install(|| scans.par_iter().zip(guesses).map(one).collect()),
-        };
+        let threads =
+            threads.unwrap_or_else(|| thread::available_parallelism().map_or(1, usize::from));
+        let results = spread(scans.len(), threads, one)?;
         // Nothing fails once the inputs are checked; should a scan still
         // fail, the first one's error is the call's.
         results
@@ -92,6 +90,52 @@ impl NdtGrid {
             .map(|(index, r)| r.map_err(in_scan(index)))
             .collect()
     }
+}
+
+/// `f(0) … f(n − 1)` in order, computed by the calling thread and up to
+/// `threads − 1` helper threads started here, each taking the next index
+/// not yet taken. A helper that cannot be started is done without; a
+/// helper's panic becomes [`NdtError::ThreadPanicked`].
+fn spread<T: Send>(n: usize, threads: usize, f: impl Fn(usize) -> T + Sync) -> Result<Vec<T>> {
+    let next = AtomicUsize::new(0);
+    let work = || {
+        let mut done = Vec::new();
+        loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            if i >= n {
+                return done;
+            }
+            done.push((i, f(i)));
+        }
+    };
+    let helpers = threads.min(n).saturating_sub(1);
+    let mut all = thread::scope(|s| {
+        let started: Vec<_> = (0..helpers)
+            .filter_map(|_| {
+                thread::Builder::new()
+                    .name("ndtgrid-match".into())
+                    .spawn_scoped(s, work)
+                    .ok()
+            })
+            .collect();
+        let mut all = work();
+        for h in started {
+            all.extend(h.join().map_err(panic_error)?);
+        }
+        Ok::<_, NdtError>(all)
+    })?;
+    all.sort_unstable_by_key(|&(i, _)| i);
+    Ok(all.into_iter().map(|(_, t)| t).collect())
+}
+
+/// A thread's panic payload as an error.
+fn panic_error(payload: Box<dyn Any + Send>) -> NdtError {
+    let reason = payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_default();
+    NdtError::ThreadPanicked { reason }
 }
 
 #[cfg(test)]
@@ -175,6 +219,41 @@ mod tests {
                     .unwrap();
                 assert_eq!(got, want, "threads {threads:?}, phases {phases:?}");
             }
+        }
+    }
+
+    /// Every index once, in order, whatever the number of threads (more
+    /// than items too); a helper's panic is an error, not a panic.
+    #[test]
+    #[allow(clippy::panic)]
+    fn spread_keeps_order_and_reports_panics() {
+        for threads in [1, 2, 5, 64] {
+            let got = spread(37, threads, |i| (i, thread::current().id())).unwrap();
+            assert_eq!(
+                got.iter().map(|g| g.0).collect::<Vec<_>>(),
+                (0..37).collect::<Vec<_>>()
+            );
+            let ids: std::collections::HashSet<_> = got.iter().map(|g| g.1).collect();
+            assert!(ids.len() <= threads.min(37));
+        }
+        assert!(spread(0, 4, |i| i).unwrap().is_empty());
+        let caller = thread::current().id();
+        let err = spread(64, 2, |i| {
+            if thread::current().id() != caller {
+                panic!("scan {i} failed");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(1));
+            i
+        });
+        match err {
+            // The helper may not have taken any index before the caller took them all.
+            Ok(v) => assert_eq!(v.len(), 64),
+            Err(e) => assert!(
+                e.to_string().starts_with(
+                    "internal error: a thread matching scans of the batch panicked: scan "
+                ),
+                "{e}"
+            ),
         }
     }
 

@@ -10,8 +10,8 @@ use pyo3::PyErr;
 /// operation is an `OSError` with the error number, so that Python picks the
 /// subclass (`FileNotFoundError`, `IsADirectoryError`, ...), and the file
 /// name. An odometry's mapper that lost scans across a fork, or asked of a
-/// loop that builds none, is a `RuntimeError`: nothing the call passed was
-/// wrong.
+/// loop that builds none, and a helper thread of `match_many` that panicked
+/// (a bug) are a `RuntimeError`: nothing the call passed was wrong.
 pub fn to_py(err: NdtError) -> PyErr {
     match err {
         NdtError::Io {
@@ -21,7 +21,9 @@ pub fn to_py(err: NdtError) -> PyErr {
             message,
         } => PyOSError::new_err((errno, format!("cannot {action}: {message}"), path)),
         NdtError::Io { .. } => PyOSError::new_err(err.to_string()),
-        NdtError::MapperLost { .. } | NdtError::NoMap => PyRuntimeError::new_err(err.to_string()),
+        NdtError::MapperLost { .. } | NdtError::NoMap | NdtError::ThreadPanicked { .. } => {
+            PyRuntimeError::new_err(err.to_string())
+        }
         other => PyValueError::new_err(other.to_string()),
     }
 }
