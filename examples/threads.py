@@ -1,4 +1,4 @@
-"""Match scans on two cores from Python threads, each pinned to its own core.
+"""Match scans on two cores: from Python threads pinned to their cores, or in one call.
 
 ``NdtGrid.match`` releases the GIL while the core works, so two threads matching
 different scans against one map run in parallel. On Linux, pin each worker thread to
@@ -7,11 +7,18 @@ thread on the core of the busy thread that woke it, and the two then take turns 
 core for milliseconds. ``os.sched_setaffinity(0, ...)`` in a thread pins that thread
 only; a ``ThreadPoolExecutor`` initializer runs once in each worker.
 
+With the scans at hand as a batch, no threads of your own are needed:
+``grid.match_many(scans, guesses)`` matches them on every core in one call (the calling
+thread and helpers started for the batch, which the kernel places on idle cores), each
+result bit for bit that of its own ``match``.
+
 Runnable as is (simulated URG-04LX scans of the paper's sticks room, no data needed);
-prints the matches per second of one thread and of two pinned workers, and checks that
-both give the same poses, bit for bit. The gain is what the two cores have free: on this
-project's 2-vCPU VM, 1.4-1.5x in a phase in which the VM gave GIL-free work (SHA-256)
-1.5x, and 1.59-2.00x over thirteen runs of ``benches/speed.py``'s thread section.
+prints the matches per second of one thread, of two pinned workers and of one
+``match_many`` call, and checks that all give the same poses, bit for bit. The gain is
+what the two cores have free: on this project's 2-vCPU VM, pinned workers gave 1.4-1.5x
+in a phase in which the VM gave GIL-free work (SHA-256) 1.5x, and 1.59-2.00x over
+thirteen runs of ``benches/speed.py``'s thread section (BENCHMARK.md, "Speed", session
+29; ``match_many`` in session 30).
 """
 
 import itertools
@@ -82,8 +89,15 @@ with ThreadPoolExecutor(max_workers=workers, initializer=pin) as pool:
 two: list[np.ndarray] = [np.empty(0)] * len(jobs)
 for i, part in enumerate(parts):
     two[i::workers] = part
-same = all(np.array_equal(a, b) for a, b in zip(one, two))
+
+# The same scans in one call, on every core.
+t0 = time.perf_counter()
+batch = grid.match_many([points for points, _ in jobs], np.array([g for _, g in jobs]))
+t_many = time.perf_counter() - t0
+
+same = all(np.array_equal(a, b) and np.array_equal(a, r.pose) for a, b, r in zip(one, two, batch))
 print(f"{len(jobs)} scans, map of {len(grid)} cells; worker CPUs: {sorted(pinned)}")
 print(f"one thread: {len(jobs) / t_one:.0f} matches/s")
 print(f"{workers} pinned workers: {len(jobs) / t_two:.0f} matches/s ({t_one / t_two:.2f}x)")
+print(f"one match_many call: {len(jobs) / t_many:.0f} matches/s ({t_one / t_many:.2f}x)")
 print(f"same poses: {same}")

@@ -43,6 +43,7 @@ def test_threads_example_pins_its_workers_and_matches_alike() -> None:
     else:
         assert m.group(1) == "[]"
     assert re.search(r"one thread: \d+ matches/s", out), out
+    assert re.search(r"one match_many call: \d+ matches/s", out), out
 
 
 def test_version_from_the_command_line() -> None:
