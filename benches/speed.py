@@ -1328,7 +1328,9 @@ def plot_threads(runs: dict[str, list[float]], path: Path) -> None:
     b.xaxis.get_major_locator().set_params(integer=True)
     b.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))
     save_figure(
-        fig, "Two Python threads matching different scans on one 2 cm map (benches/speed.py)", path
+        fig,
+        "Matching different scans on two cores against one 2 cm map (benches/speed.py)",
+        path,
     )
 
 

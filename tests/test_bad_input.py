@@ -15,6 +15,7 @@ ragged nested lists             TypeError    points: expected an array-like of r
 points with NaN                 ValueError   points: expected finite values, got NaN at index i
 points with +/-inf              ValueError   points: expected finite values, got inf at index i
 empty scan to match, (0, 2)     ValueError   points: expected at least one point, got 0
+expansion_phases=[] (match)     ValueError   expansion_phases: expected at least one expansion...
 huge coordinates (insert)       ValueError   points: point i at (x, y) m is outside the grid's
                                              range of ±R m (cell index would overflow)
 huge coordinates (match)        ValueError   same
@@ -174,6 +175,12 @@ CASES: list[tuple[str, Callable[[ndtgrid.NdtGrid], Any], type[Exception], str]] 
         lambda g: g.match(np.zeros((0, 2)), POSE),
         ValueError,
         "points: expected at least one point, got 0",
+    ),
+    (
+        "no expansion phases",
+        lambda g: g.match(GOOD, POSE, expansion_phases=[]),
+        ValueError,
+        "expansion_phases: expected at least one expansion, got 0",
     ),
     (
         "huge insert",
