@@ -68,6 +68,30 @@ def run_match(grid: ndtgrid.NdtGrid, q: int) -> tuple[Any, ...]:
     return key(grid.match(pts, guess))
 
 
+def insert_while_reading(
+    readers: list[threading.Thread],
+    seen: list[Any],
+    insert: Callable[[int], None],
+    done: threading.Event,
+    errors: list[BaseException],
+) -> None:
+    """Start the readers, make inserts ``1 .. len(SCANS) - 1`` one by one, each once
+    every reader has had one more result (without this, on a busy machine they might
+    all start after the last insert), then let the readers end; fail on a reader that
+    hangs (a deadlock) or raised."""
+    for t in readers:
+        t.start()
+    for k in range(1, len(SCANS)):
+        n = results(seen)
+        wait_until(lambda n=n: results(seen) >= n + len(readers))
+        insert(k)
+    done.set()
+    for t in readers:
+        t.join(JOIN_TIMEOUT)
+    assert not any(t.is_alive() for t in readers), "a reader hung (deadlock?)"
+    assert not errors, errors
+
+
 def states_of(insert: Callable[[Any, int], None], make: Callable[[], Any]) -> list[list[Any]]:
     """``ref[k][q]``: query ``q`` after ``k`` inserts, on a fresh replay."""
     target = make()
@@ -150,19 +174,7 @@ def test_matches_while_one_thread_inserts_see_whole_states_in_order(
             errors.append(e)
 
     threads = [threading.Thread(target=reader, args=(i,), daemon=True) for i in range(N_READERS)]
-    for t in threads:
-        t.start()
-    for k in range(1, len(SCANS)):
-        # Let the readers see this state before the next insert (without this, on a
-        # busy machine they might all start after the last insert).
-        n = results(seen)
-        wait_until(lambda n=n: results(seen) >= n + N_READERS)
-        insert(target, k)
-    done.set()
-    for t in threads:
-        t.join(JOIN_TIMEOUT)
-    assert not any(t.is_alive() for t in threads), "a reader hung (deadlock?)"
-    assert not errors, errors
+    insert_while_reading(threads, seen, lambda k: insert(target, k), done, errors)
 
     reached = set()
     for i in range(N_READERS):
@@ -205,17 +217,7 @@ def test_match_many_while_one_thread_inserts_sees_one_state_per_batch() -> None:
             errors.append(e)
 
     threads = [threading.Thread(target=reader, args=(i,), daemon=True) for i in range(2)]
-    for t in threads:
-        t.start()
-    for k in range(1, len(SCANS)):
-        n = results(seen)
-        wait_until(lambda n=n: results(seen) >= n + 2)
-        insert_grid(grid, k)
-    done.set()
-    for t in threads:
-        t.join(JOIN_TIMEOUT)
-    assert not any(t.is_alive() for t in threads), "a reader hung (deadlock?)"
-    assert not errors, errors
+    insert_while_reading(threads, seen, lambda k: insert_grid(grid, k), done, errors)
     for i in range(2):
         states = []
         for batch in seen[i]:

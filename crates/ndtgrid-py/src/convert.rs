@@ -92,20 +92,29 @@ fn as_f64_contiguous<'py>(arr: Bound<'py, PyUntypedArray>) -> PyResult<Bound<'py
         .call1((arr, numpy::dtype::<f64>(py)))
 }
 
-/// Validates and borrows `(N, 2)` points named `what`.
-pub fn points<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Points<'py>> {
-    let arr = real_array(obj, what)?;
-    let shape = arr.shape();
-    if shape.len() != 2 || shape[1] != 2 {
+/// `arr` (named `what`) as a C-contiguous float64 array of `cols` columns,
+/// copied only when it is not one; `shape` is the shape the error names.
+fn rows_of<'py>(
+    arr: Bound<'py, PyUntypedArray>,
+    what: &str,
+    cols: usize,
+    shape: &str,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let got = arr.shape();
+    if got.len() != 2 || got[1] != cols {
         return Err(PyValueError::new_err(format!(
-            "{what}: expected an array of shape (N, 2), got shape {}",
-            shape_text(shape)
+            "{what}: expected an array of shape {shape}, got shape {}",
+            shape_text(got)
         )));
     }
-    let array = as_f64_contiguous(arr)?
+    as_f64_contiguous(arr)?
         .cast_into::<PyArray2<f64>>()
-        .map_err(|e| PyTypeError::new_err(format!("{what}: {e}")))?
-        .readonly();
+        .map_err(|e| PyTypeError::new_err(format!("{what}: {e}")))
+}
+
+/// Validates and borrows `(N, 2)` points named `what`.
+pub fn points<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Points<'py>> {
+    let array = rows_of(real_array(obj, what)?, what, 2, "(N, 2)")?.readonly();
     Ok(Points { array })
 }
 
@@ -167,19 +176,10 @@ pub fn pose(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 3]> {
 /// empty sequence is no pose).
 pub fn poses(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f64; 3]>> {
     let arr = real_array(obj, what)?;
-    let shape = arr.shape();
-    if shape == [0] {
+    if arr.shape() == [0] {
         return Ok(Vec::new());
     }
-    if shape.len() != 2 || shape[1] != 3 {
-        return Err(PyValueError::new_err(format!(
-            "{what}: expected an array of shape (K, 3), one [x, y, theta] per row, got shape {}",
-            shape_text(shape)
-        )));
-    }
-    let arr = as_f64_contiguous(arr)?
-        .cast_into::<PyArray2<f64>>()
-        .map_err(|e| PyTypeError::new_err(format!("{what}: {e}")))?;
+    let arr = rows_of(arr, what, 3, "(K, 3), one [x, y, theta] per row")?;
     // Copied while the GIL is held: no borrow of the array to track.
     let flat = arr
         .to_vec()

@@ -76,6 +76,12 @@ pub fn options_from_kwargs(
             |e: PyErr| PyTypeError::new_err(format!("argument '{name}': {}", e.value(key.py())));
         let real = || value.extract::<f64>().map_err(typed);
         let flag = || value.extract::<bool>().map_err(typed);
+        let whole = || {
+            value
+                .extract::<i64>()
+                .map_err(typed)
+                .and_then(|v| count(&name, v))
+        };
         match name.as_str() {
             "expansion" => o.expansion = real()?,
             "sigma_floor" => o.sigma_floor = real()?,
@@ -83,12 +89,8 @@ pub fn options_from_kwargs(
             "neighbor_search" => o.neighbor_search = flag()?,
             "fuse_minority" => o.fuse_minority = flag()?,
             "pair_neighbors" => o.pair_neighbors = flag()?,
-            "search_radius" => {
-                o.search_radius = count("search_radius", value.extract().map_err(typed)?)?;
-            }
-            "max_iterations" => {
-                o.max_iterations = count("max_iterations", value.extract().map_err(typed)?)?;
-            }
+            "search_radius" => o.search_radius = whole()?,
+            "max_iterations" => o.max_iterations = whole()?,
             "translation_tolerance" => o.translation_tolerance = real()?,
             "rotation_tolerance" => o.rotation_tolerance = real()?,
             "max_step_cells" => o.max_step_cells = real()?,
