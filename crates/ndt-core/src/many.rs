@@ -119,10 +119,18 @@ fn spread<T: Send>(n: usize, threads: usize, f: impl Fn(usize) -> T + Sync) -> R
             })
             .collect();
         let mut all = work();
+        // Every helper joined before any is reported: a scope with a
+        // panicked helper not joined would panic itself.
+        let mut failed = None;
         for h in started {
-            all.extend(h.join().map_err(panic_error)?);
+            match h.join() {
+                Ok(done) => all.extend(done),
+                Err(payload) => {
+                    failed.get_or_insert(panic_error(payload));
+                }
+            }
         }
-        Ok::<_, NdtError>(all)
+        failed.map_or(Ok(all), Err)
     })?;
     all.sort_unstable_by_key(|&(i, _)| i);
     Ok(all.into_iter().map(|(_, t)| t).collect())
@@ -237,24 +245,30 @@ mod tests {
             assert!(ids.len() <= threads.min(37));
         }
         assert!(spread(0, 4, |i| i).unwrap().is_empty());
+        // Three helpers, each panicking on the first index it takes; the
+        // calling thread waits (up to 10 s) until all three have panicked.
         let caller = thread::current().id();
-        let err = spread(64, 2, |i| {
+        let panicked = AtomicUsize::new(0);
+        let err = spread(64, 4, |i| {
             if thread::current().id() != caller {
+                panicked.fetch_add(1, Ordering::SeqCst);
                 panic!("scan {i} failed");
             }
-            std::thread::sleep(std::time::Duration::from_millis(1));
+            for _ in 0..10_000 {
+                if panicked.load(Ordering::SeqCst) == 3 {
+                    break;
+                }
+                thread::sleep(std::time::Duration::from_millis(1));
+            }
             i
-        });
-        match err {
-            // The helper may not have taken any index before the caller took them all.
-            Ok(v) => assert_eq!(v.len(), 64),
-            Err(e) => assert!(
-                e.to_string().starts_with(
-                    "internal error: a thread matching scans of the batch panicked: scan "
-                ),
-                "{e}"
+        })
+        .unwrap_err();
+        assert!(
+            err.to_string().starts_with(
+                "internal error: a thread matching scans of the batch panicked: scan "
             ),
-        }
+            "{err}"
+        );
     }
 
     #[test]

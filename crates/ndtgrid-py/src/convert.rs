@@ -29,7 +29,7 @@ impl Points<'_> {
     }
 }
 
-pub fn shape_text(shape: &[usize]) -> String {
+fn shape_text(shape: &[usize]) -> String {
     match shape {
         [n] => format!("({n},)"),
         _ => format!(
@@ -116,6 +116,34 @@ fn rows_of<'py>(
 pub fn points<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Points<'py>> {
     let array = rows_of(real_array(obj, what)?, what, 2, "(N, 2)")?.readonly();
     Ok(Points { array })
+}
+
+/// Validates and borrows a sequence named `what` of `(N, 2)` points (a list
+/// of arrays, or one array of shape `(K, N, 2)`); item `i` is named `scan i:
+/// points` in errors.
+pub fn point_sets<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Vec<Points<'py>>> {
+    if let Ok(one) = obj.cast::<PyUntypedArray>() {
+        if one.ndim() < 3 {
+            return Err(PyTypeError::new_err(format!(
+                "{what}: expected a sequence of (N, 2) arrays, got one array of shape {} \
+                 (one scan: use match)",
+                shape_text(one.shape())
+            )));
+        }
+    }
+    let items = obj.try_iter().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{what}: expected a sequence of (N, 2) arrays, got {}",
+            obj.get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        ))
+    })?;
+    items
+        .enumerate()
+        .map(|(i, item)| points(&item?, &format!("scan {i}: points")))
+        .collect()
 }
 
 /// A 1-D float64 array, borrowed from a C-contiguous numpy array.

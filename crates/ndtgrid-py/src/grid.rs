@@ -9,12 +9,11 @@ use std::path::PathBuf;
 use std::sync::{Arc, RwLock};
 
 use ndt_core::{MatchOptions, NdtGrid, Pose2};
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
-use pyo3::exceptions::PyTypeError;
+use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyType};
 
-use crate::convert::{count, level_mask, mat3, points, pose, poses, rows, shape_text, vec3};
+use crate::convert::{count, level_mask, mat3, point_sets, points, pose, poses, rows, vec3};
 use crate::errors::{poisoned, to_py};
 use crate::match_options::options_from_kwargs;
 use crate::result::PyMatchResult;
@@ -221,29 +220,7 @@ impl PyNdtGrid {
         let threads = threads
             .map(|t| count("threads", t).map(|t| t as usize))
             .transpose()?;
-        if let Ok(one) = scans.cast::<PyUntypedArray>() {
-            if one.ndim() < 3 {
-                return Err(PyTypeError::new_err(format!(
-                    "scans: expected a sequence of (N, 2) arrays, got one array of shape {} \
-                     (one scan: use match)",
-                    shape_text(one.shape())
-                )));
-            }
-        }
-        let items = scans.try_iter().map_err(|_| {
-            PyTypeError::new_err(format!(
-                "scans: expected a sequence of (N, 2) arrays, got {}",
-                scans
-                    .get_type()
-                    .name()
-                    .map(|n| n.to_string())
-                    .unwrap_or_default()
-            ))
-        })?;
-        let arrays = items
-            .enumerate()
-            .map(|(i, item)| points(&item?, &format!("scan {i}: points")))
-            .collect::<PyResult<Vec<_>>>()?;
+        let arrays = point_sets(scans, "scans")?;
         let pairs = arrays
             .iter()
             .map(|a| a.as_pairs())
