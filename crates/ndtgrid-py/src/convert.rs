@@ -43,6 +43,14 @@ fn shape_text(shape: &[usize]) -> String {
     }
 }
 
+/// The name of `obj`'s type, for messages (empty if it has none).
+fn type_name(obj: &Bound<'_, PyAny>) -> String {
+    obj.get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_default()
+}
+
 /// `numpy.asarray(obj)` with a `TypeError` naming `what` when `obj` is not
 /// array-like, and with the dtype checked to be real numbers.
 fn real_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyUntypedArray>> {
@@ -60,10 +68,7 @@ fn real_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, P
     let arr = arr.map_err(|_| {
         PyTypeError::new_err(format!(
             "{what}: expected an array-like of real numbers, got {}",
-            obj.get_type()
-                .name()
-                .map(|n| n.to_string())
-                .unwrap_or_default()
+            type_name(obj)
         ))
     })?;
     let arr = arr.cast_into::<PyUntypedArray>().map_err(|_| {
@@ -134,10 +139,7 @@ pub fn point_sets<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Vec<Poin
     let items = obj.try_iter().map_err(|_| {
         PyTypeError::new_err(format!(
             "{what}: expected a sequence of (N, 2) arrays, got {}",
-            obj.get_type()
-                .name()
-                .map(|n| n.to_string())
-                .unwrap_or_default()
+            type_name(obj)
         ))
     })?;
     items
