@@ -375,12 +375,14 @@ class NdtGrid:
             Initial pose ``[x, y, theta]`` (m, m, rad) of each scan, one row per
             scan.
         threads : int, optional
-            Threads that match: the calling thread and ``threads - 1`` helpers
-            (never more than scans). ``None`` (default): one per core the
-            process may run on (``len(os.sched_getaffinity(0))`` on Linux); 1:
-            one scan after the other on the calling thread (with the GIL
-            released). A helper the system refuses to start leaves its share
-            to the others.
+            Threads that match: the calling thread and ``threads - 1`` helpers,
+            at most one thread per two scans (a helper costs about 0.1 ms before
+            its first scan is done, so a batch of 2 or 3 scans stays on the
+            calling thread). ``None`` (default): one per core the process may
+            run on (``len(os.sched_getaffinity(0))`` on Linux, asked once per
+            process); 1: one scan after the other on the calling thread (with
+            the GIL released). A helper the system refuses to start leaves its
+            share to the others.
         **options
             Any keyword option of :meth:`match`, with the same default.
 

@@ -12,11 +12,13 @@
 //! than woken from a pool: a new thread goes to the idlest core, whereas a
 //! sleeping pool thread woken by a busy one may be put on the waker's core
 //! and wait there for the scheduler's tick (seen on this project's VM with
-//! rayon's pool: BENCHMARK.md, "Speed", session 30). Starting a thread costs
-//! tens of microseconds, a 683-point match about 70.
+//! rayon's pool: BENCHMARK.md, "Speed", session 30). A helper costs about
+//! 0.1 ms before its first scan is done, so a batch starts one only for
+//! every [`MIN_SCANS_PER_THREAD`] scans.
 
 use std::any::Any;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::OnceLock;
 use std::thread;
 
 use crate::error::{NdtError, Result};
@@ -31,8 +33,9 @@ impl NdtGrid {
     /// in the order of the scans.
     ///
     /// `threads`: how many threads match: the calling thread and `threads −
-    /// 1` helpers (never more threads than scans). `None`: one per core the
-    /// process may run on ([`std::thread::available_parallelism`]);
+    /// 1` helpers, at most one thread per two scans.
+    /// `None`: one per core the process may run on
+    /// ([`std::thread::available_parallelism`], asked once per process);
     /// `Some(1)`: the calling thread alone. A helper the system refuses to
     /// start leaves its share to the others.
     ///
@@ -79,8 +82,7 @@ impl NdtGrid {
             Some(phases) => self.match_phased(scans[i], guesses[i], options, phases),
             None => self.match_scan(scans[i], guesses[i], options),
         };
-        let threads =
-            threads.unwrap_or_else(|| thread::available_parallelism().map_or(1, usize::from));
+        let threads = threads.unwrap_or_else(cores);
         let results = spread(scans.len(), threads, one)?;
         // Nothing fails once the inputs are checked; should a scan still
         // fail, the first one's error is the call's.
@@ -92,10 +94,28 @@ impl NdtGrid {
     }
 }
 
+/// Fewest scans a thread of a batch is started for. A helper costs about
+/// 0.1 ms before its first scan is done (starting it, and the grid's cells
+/// read into its core's caches): batches of 1, 2 and 4 simulated 683-point
+/// scans (about 0.1 ms each) on 2 cores ran at 0.74, 0.86 and 1.22× the
+/// one-thread rate with a helper for any batch (and the cores asked on
+/// every call), at 1.00, 0.99–1.01 and 1.45–1.51× with this bound and
+/// [`cores`] (BENCHMARK.md, "Speed", session 30).
+const MIN_SCANS_PER_THREAD: usize = 2;
+
+/// The cores the process may run on, asked once
+/// ([`std::thread::available_parallelism`] reads the cgroup's files: tens
+/// of microseconds a call).
+fn cores() -> usize {
+    static CORES: OnceLock<usize> = OnceLock::new();
+    *CORES.get_or_init(|| thread::available_parallelism().map_or(1, usize::from))
+}
+
 /// `f(0) … f(n − 1)` in order, computed by the calling thread and up to
-/// `threads − 1` helper threads started here, each taking the next index
-/// not yet taken. A helper that cannot be started is done without; a
-/// helper's panic becomes [`NdtError::ThreadPanicked`].
+/// `threads − 1` helper threads started here (at most one thread per
+/// [`MIN_SCANS_PER_THREAD`] items), each taking the next index not yet
+/// taken. A helper that cannot be started is done without; a helper's
+/// panic becomes [`NdtError::ThreadPanicked`].
 fn spread<T: Send>(n: usize, threads: usize, f: impl Fn(usize) -> T + Sync) -> Result<Vec<T>> {
     let next = AtomicUsize::new(0);
     let work = || {
@@ -108,7 +128,7 @@ fn spread<T: Send>(n: usize, threads: usize, f: impl Fn(usize) -> T + Sync) -> R
             done.push((i, f(i)));
         }
     };
-    let helpers = threads.min(n).saturating_sub(1);
+    let helpers = threads.min(n / MIN_SCANS_PER_THREAD).saturating_sub(1);
     let mut all = thread::scope(|s| {
         let started: Vec<_> = (0..helpers)
             .filter_map(|_| {
@@ -242,12 +262,15 @@ mod tests {
                 (0..37).collect::<Vec<_>>()
             );
             let ids: std::collections::HashSet<_> = got.iter().map(|g| g.1).collect();
-            assert!(ids.len() <= threads.min(37));
+            assert!(ids.len() <= threads.min(37 / MIN_SCANS_PER_THREAD));
         }
         assert!(spread(0, 4, |i| i).unwrap().is_empty());
+        // Fewer than two items per thread: the calling thread alone.
+        let caller = thread::current().id();
+        let small = spread(3, 8, |_| thread::current().id()).unwrap();
+        assert_eq!(small, vec![caller; 3]);
         // Three helpers, each panicking on the first index it takes; the
         // calling thread waits (up to 10 s) until all three have panicked.
-        let caller = thread::current().id();
         let panicked = AtomicUsize::new(0);
         let err = spread(64, 4, |i| {
             if thread::current().id() != caller {
