@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import math
 import threading
 import time
 from pathlib import Path
@@ -203,7 +204,11 @@ def test_the_gil_is_free_while_it_runs() -> None:
     grid = room_map()
     scans, guesses = batch(8)
     grid.match_many(scans[:1], guesses[:1])  # distributions built
-    scans, guesses = scans * 500, np.vstack([guesses] * 500)
+    # Enough copies for a call of about 0.3 s on this machine.
+    t0 = time.perf_counter()
+    grid.match_many(scans, guesses, threads=1)
+    copies = max(1, math.ceil(0.3 / (time.perf_counter() - t0)))
+    scans, guesses = scans * copies, np.vstack([guesses] * copies)
     count = [0]
     stop = threading.Event()
 
