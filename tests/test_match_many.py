@@ -14,6 +14,7 @@ import pytest
 
 import ndtgrid
 
+from ._results import exact
 from ._room import scan
 
 #: Poses in the room of ``_room.scan`` (the map's four and ten more).
@@ -43,20 +44,6 @@ def batch(k: int, seed: int = 3) -> tuple[list[np.ndarray], np.ndarray]:
     return scans, truths + offsets
 
 
-def fields(r: ndtgrid.MatchResult) -> tuple[Any, ...]:
-    """Everything a result holds, as exact values."""
-    return (
-        r.pose.tolist(),
-        r.converged,
-        r.iterations,
-        r.score,
-        r.num_matched,
-        r.hessian.tolist(),
-        r.covariance.tolist(),
-        r.unconstrained.tolist(),
-    )
-
-
 @pytest.mark.parametrize("threads", [None, 1, 2, 3])
 @pytest.mark.parametrize(
     "options",
@@ -70,9 +57,9 @@ def fields(r: ndtgrid.MatchResult) -> tuple[Any, ...]:
 def test_each_result_is_its_own_match(threads: int | None, options: dict[str, Any]) -> None:
     grid = room_map()
     scans, guesses = batch(17)
-    want = [fields(grid.match(s, g, **options)) for s, g in zip(scans, guesses)]
+    want = [exact(grid.match(s, g, **options)) for s, g in zip(scans, guesses)]
     got = grid.match_many(scans, guesses, threads=threads, **options)
-    assert [fields(r) for r in got] == want
+    assert [exact(r) for r in got] == want
     assert sum(r.converged for r in got) >= 15
 
 
@@ -83,7 +70,7 @@ def test_takes_every_keyword_of_match() -> None:
     scans, guesses = batch(4)
     core = ndtgrid.default_match_options()
     got = grid.match_many(scans, guesses, **core)
-    assert [fields(r) for r in got] == [fields(grid.match(s, g)) for s, g in zip(scans, guesses)]
+    assert [exact(r) for r in got] == [exact(grid.match(s, g)) for s, g in zip(scans, guesses)]
     tree = ast.parse(Path(ndtgrid.__file__).with_name("_core.pyi").read_text())
     typed = next(c for c in tree.body if isinstance(c, ast.ClassDef) and c.name == "_MatchOptions")
     keys = {
@@ -99,7 +86,7 @@ def test_scans_as_one_3d_array_and_empty_batches() -> None:
     pts = scan((0.1, 0.0, 0.2), seed=9)
     guesses = np.array([[0.12, -0.01, 0.21], [0.08, 0.01, 0.19]])
     stacked = grid.match_many(np.stack([pts, pts]), guesses)
-    assert [fields(r) for r in stacked] == [fields(grid.match(pts, g)) for g in guesses]
+    assert [exact(r) for r in stacked] == [exact(grid.match(pts, g)) for g in guesses]
     assert grid.match_many([], []) == []
     assert grid.match_many([], np.empty((0, 3)), threads=1) == []
 

@@ -34,6 +34,7 @@ import pytest
 
 import ndtgrid
 
+from ._results import exact
 from ._room import scan
 
 N_READERS = 4
@@ -51,21 +52,9 @@ QUERIES = [
 ]
 
 
-def key(r: ndtgrid.MatchResult) -> tuple[Any, ...]:
-    """Everything a match returns, as exact bytes."""
-    return (
-        r.pose.tobytes(),
-        float(r.score).hex(),
-        r.hessian.tobytes(),
-        r.iterations,
-        r.num_matched,
-        r.converged,
-    )
-
-
 def run_match(grid: ndtgrid.NdtGrid, q: int) -> tuple[Any, ...]:
     pts, guess = QUERIES[q]
-    return key(grid.match(pts, guess))
+    return exact(grid.match(pts, guess))
 
 
 def insert_while_reading(
@@ -210,7 +199,7 @@ def test_match_many_while_one_thread_inserts_sees_one_state_per_batch() -> None:
             while True:
                 last_round = done.is_set()
                 batch = grid.match_many(scans, guesses, threads=1 + i)
-                seen[i].append([key(r) for r in batch])
+                seen[i].append([exact(r) for r in batch])
                 if last_round:
                     break
         except BaseException as e:  # pragma: no cover - reported below

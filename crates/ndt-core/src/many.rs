@@ -55,7 +55,7 @@ impl NdtGrid {
         if let Some(phases) = phases {
             check_phases(options, phases)?;
         }
-        self.match_levels(options)?;
+        let levels = self.match_levels(options)?;
         if threads == Some(0) {
             return Err(NdtError::InvalidOption {
                 name: "threads",
@@ -78,9 +78,10 @@ impl NdtGrid {
         for (index, (points, guess)) in scans.iter().zip(guesses).enumerate() {
             self.check_scan(points, *guess).map_err(in_scan(index))?;
         }
+        // Checked above: each scan is not checked again.
         let one = |i: usize| match phases {
             Some(phases) => self.match_phased(scans[i], guesses[i], options, phases),
-            None => self.match_scan(scans[i], guesses[i], options),
+            None => self.match_checked(scans[i], guesses[i], options, levels),
         };
         let threads = threads.unwrap_or_else(cores);
         let results = spread(scans.len(), threads, one)?;

@@ -716,6 +716,19 @@ impl NdtGrid {
         options.validate()?;
         self.check_scan(points, guess)?;
         let levels = self.match_levels(options)?;
+        self.match_checked(points, guess, options, levels)
+    }
+
+    /// [`NdtGrid::match_scan`] once its input is checked (`options` valid,
+    /// [`NdtGrid::check_scan`] passed) on `levels` levels
+    /// ([`NdtGrid::match_levels`]).
+    pub(crate) fn match_checked(
+        &self,
+        points: &[[f64; 2]],
+        guess: Pose2,
+        options: &MatchOptions,
+        levels: usize,
+    ) -> Result<MatchResult> {
         // The scan's RMS radius: the lever arm that makes rotation comparable
         // with translation in the degeneracy analysis.
         let lever = (points
