@@ -12,6 +12,9 @@
     The same on the paper's simulated sticks room (:mod:`ndtgrid.sim`, a URG-04LX with
     drifting odometry): no data needed; also reports the pose error against the
     simulator's truth and the small objects (sticks) found.
+``ndtgrid bench [--scans N] [--json]``
+    Time insert, match, ``match_many`` and the odometry loop of the installed library on
+    simulated scans (:mod:`ndtgrid.bench`): no data needed.
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ndtgrid import __version__
+from ndtgrid._progress import progress
 from ndtgrid.io import Scan
 
 if TYPE_CHECKING:
@@ -43,8 +47,10 @@ def build_parser() -> argparse.ArgumentParser:
     Returns
     -------
     argparse.ArgumentParser
-        Parser with ``--version`` and the subcommands ``map`` and ``eval``.
+        Parser with ``--version`` and the subcommands ``map``, ``demo``, ``bench`` and
+        ``eval``.
     """
+    from ndtgrid import bench
     from ndtgrid.io import LOG_FORMATS
 
     parser = argparse.ArgumentParser(
@@ -82,6 +88,24 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--out", default="demo-out", help="output directory (default: demo-out)")
     d.add_argument("--seed", type=int, default=0, help="simulation seed (0)")
     d.add_argument("--quiet", action="store_true", help="no progress bar")
+    b = sub.add_parser(
+        "bench",
+        help="time insert, match and the odometry loop on this machine (no data needed)",
+        description="Time the installed library on simulated URG-04LX scans of the sticks "
+        "room: insert into a 2 cm map, match (checked against the truth), match_many on "
+        "one thread and on every core, and the odometry loop. No data or other library "
+        "is needed; benches/speed.py in the source tree compares peers on real logs.",
+    )
+    b.add_argument(
+        "--scans",
+        type=int,
+        default=None,
+        help=f"simulated scans, {bench.MIN_SCANS} to {bench.max_scans()} (default: all "
+        f"{bench.max_scans()} poses of the simulated tour)",
+    )
+    b.add_argument("--seed", type=int, default=0, help="simulation seed (0)")
+    b.add_argument("--json", action="store_true", help="print the report as JSON")
+    b.add_argument("--quiet", action="store_true", help="no progress bars")
     e = sub.add_parser(
         "eval",
         help="relation error of a trajectory against a reference (Kümmerle et al. 2009)",
@@ -107,26 +131,6 @@ def build_parser() -> argparse.ArgumentParser:
     )
     e.add_argument("--json", action="store_true", help="print the summary as JSON")
     return parser
-
-
-def _progress(items: Iterable[T], quiet: bool) -> Iterator[T]:
-    """``items`` with a tqdm progress bar on stderr, or a plain counter without tqdm."""
-    if quiet:
-        yield from items
-        return
-    try:
-        from tqdm import tqdm  # type: ignore[import-untyped,unused-ignore]
-    except ImportError:
-        start = time.perf_counter()
-        n = 0
-        for n, item in enumerate(items, start=1):
-            if n % 500 == 0:
-                rate = n / max(time.perf_counter() - start, 1e-9)
-                print(f"\r{n} scans ({rate:.0f} scans/s)", end="", file=sys.stderr)
-            yield item
-        print(f"\r{n} scans", file=sys.stderr)
-        return
-    yield from tqdm(items, unit="scan", desc="mapping", file=sys.stderr)
 
 
 def usable_ranges(scan: Scan) -> npt.NDArray[np.float64]:
@@ -163,7 +167,7 @@ def map_scans(
     free = FreeSpace(resolution)
     times: list[float] = []
     start = time.perf_counter()
-    for i, scan in enumerate(_progress(scans, quiet)):
+    for i, scan in enumerate(progress(scans, quiet, "mapping")):
         prior = scan.laser_pose if scan.laser_pose is not None else scan.odom
         pose = odo.step(usable_ranges(scan), scan.angles, prior)
         step = odo.last_step
@@ -265,6 +269,22 @@ def run_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def run_bench(args: argparse.Namespace) -> int:
+    """``ndtgrid bench``: see :func:`build_parser`."""
+    from ndtgrid import bench
+
+    def bars(items: Iterable[T], label: str, total: int) -> Iterator[T]:
+        return progress(items, args.quiet, label, total=total)
+
+    try:
+        report = bench.run_bench(args.scans, seed=args.seed, progress=bars)
+    except ValueError as err:
+        print(f"ndtgrid bench: {err}", file=sys.stderr)
+        return 2
+    print(json.dumps(report.as_dict()) if args.json else report.table())
+    return 0
+
+
 def run_eval(args: argparse.Namespace) -> int:
     """``ndtgrid eval``: see :func:`build_parser`."""
     from ndtgrid.evaluation import associate, relation_errors
@@ -322,5 +342,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return run_eval(args)
     if args.command == "demo":
         return run_demo(args)
+    if args.command == "bench":
+        return run_bench(args)
     parser.print_help()
     return 0

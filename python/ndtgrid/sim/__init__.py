@@ -20,7 +20,7 @@ Examples
 from __future__ import annotations
 
 from ndtgrid.sim.laser import SICK_LMS, URG04LX, Laser, cast_rays
-from ndtgrid.sim.trajectory import odometry, simulate, trajectory
+from ndtgrid.sim.trajectory import odometry, scan_ranges, simulate, trajectory
 from ndtgrid.sim.world import SMALL_DIAMETER, World, sticks_room
 
 __all__ = [
@@ -31,6 +31,7 @@ __all__ = [
     "World",
     "cast_rays",
     "odometry",
+    "scan_ranges",
     "simulate",
     "sticks_room",
     "trajectory",

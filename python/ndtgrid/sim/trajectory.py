@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 import numpy.typing as npt
 
@@ -9,7 +11,7 @@ from ndtgrid import se2
 from ndtgrid.sim.laser import Laser
 from ndtgrid.sim.world import World
 
-__all__ = ["odometry", "simulate", "trajectory"]
+__all__ = ["odometry", "scan_ranges", "simulate", "trajectory"]
 
 F64 = npt.NDArray[np.float64]
 
@@ -158,8 +160,33 @@ def simulate(
         Beam angles in the sensor frame [rad].
     """
     p = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
-    streams = np.random.SeedSequence(seed).spawn(len(p))
     ranges = np.empty((len(p), laser.num_beams))
-    for k, (pose, ss) in enumerate(zip(p, streams)):
-        ranges[k], _ = laser.scan(world, pose, np.random.default_rng(ss))
+    for k, r in enumerate(scan_ranges(world, laser, p, seed=seed)):
+        ranges[k] = r
     return ranges, laser.angles
+
+
+def scan_ranges(
+    world: World,
+    laser: Laser,
+    poses: npt.ArrayLike,
+    *,
+    seed: int = 0,
+) -> Iterator[F64]:
+    """The ranges of :func:`simulate`, one scan at a time (e.g. behind a progress bar).
+
+    Parameters
+    ----------
+    world, laser, poses, seed
+        As for :func:`simulate`.
+
+    Yields
+    ------
+    ndarray, shape (B,)
+        Ranges [m] of each pose in turn, 0 = no return: row ``k`` of :func:`simulate`'s
+        ``ranges``.
+    """
+    p = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
+    streams = np.random.SeedSequence(seed).spawn(len(p))
+    for pose, ss in zip(p, streams):
+        yield laser.scan(world, pose, np.random.default_rng(ss))[0]

@@ -1,0 +1,355 @@
+"""How fast the installed library runs on this machine: ``ndtgrid bench``.
+
+The scans are simulated (the paper's sticks room seen by a URG-04LX, 683 beams, from
+:mod:`ndtgrid.sim`), so neither data nor another library is needed, and every number
+comes with a check that the work was done right: matches must recover the true pose,
+and the odometry's error against the simulator's truth is reported beside its speed.
+
+What is timed, one call at a time on the calling thread (wall clock,
+:func:`time.perf_counter_ns`), Python's call overhead included:
+
+- ``insert``: :meth:`ndtgrid.NdtGrid.insert` of each scan at its true pose into a 2 cm map
+  that holds the scans before it. As in a SLAM loop, the map's distributions are prepared
+  (by an untimed :meth:`~ndtgrid.NdtGrid.match` before each insert), so each insert also
+  keeps them up to date.
+- ``match``: :meth:`ndtgrid.NdtGrid.match` of each scan against the finished map, from its
+  true pose moved by 3 cm, -2 cm and 1 degree.
+- ``match_many``: the same matches in one :meth:`~ndtgrid.NdtGrid.match_many` call, on one
+  thread and then on every core.
+- ``odometry``: :meth:`ndtgrid.Odometry.step` over the scans with drifting odometry, the
+  whole SLAM front end (matching, its own grid's upkeep, and the §V map on a helper
+  thread, waited for at the end).
+
+The project's own benchmarks, with peer libraries and real logs, are
+``benches/speed.py`` and ``cargo bench`` in the source tree (``BENCHMARK.md``).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import platform
+import time
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ndtgrid import __version__, se2, sim
+from ndtgrid._core import NdtGrid, ranges_to_points
+from ndtgrid.evaluation import pose_error
+from ndtgrid.odometry import Odometry
+
+__all__ = ["MIN_SCANS", "BenchReport", "BenchRow", "max_scans", "run_bench"]
+
+F64 = npt.NDArray[np.float64]
+
+#: Fewest scans a run takes: enough for medians and a map that holds several scans.
+MIN_SCANS = 20
+#: Cell size of every grid of the run [m] (the paper's 2 cm).
+CELL_SIZE = 0.02
+#: How far each match's guess is from the true pose: x, y [m], theta [rad].
+GUESS_OFFSET = (0.03, -0.02, math.radians(1.0))
+#: A match recovered the pose when it ends this close to the truth: [m], [rad].
+RECOVERED = (0.01, math.radians(0.2))
+#: Drift of the simulated odometry the odometry loop is given (fraction of the motion).
+ODOMETRY_DRIFT = 0.02
+#: Inserts before the timed ones (the map first holds a few scans).
+UNTIMED_INSERTS = 10
+
+
+@dataclass(frozen=True)
+class BenchRow:
+    """One timed operation of :func:`run_bench`.
+
+    Attributes
+    ----------
+    name : str
+        What was timed (``"insert"``, ``"match"``, ...).
+    unit : str
+        Unit of ``median`` and ``p90`` (``"ms"`` or ``"µs"`` per call).
+    median : float
+        Median time of a call, in ``unit`` (for a batch timed as a whole: its time over
+        ``calls``).
+    p90 : float or None
+        90th percentile of the calls' times, in ``unit``; ``None`` for a batch.
+    calls : int
+        Calls (or scans of a batch) timed.
+    note : str
+        What the run checked or counted alongside (e.g. how many poses were recovered).
+    """
+
+    name: str
+    unit: str
+    median: float
+    p90: float | None
+    calls: int
+    note: str
+
+
+@dataclass(frozen=True)
+class BenchReport:
+    """The result of :func:`run_bench`.
+
+    Attributes
+    ----------
+    rows : tuple of BenchRow
+        The timed operations, in the order run.
+    scans : int
+        Simulated scans the run used.
+    points : int
+        Median points per scan (of the URG-04LX's 683 beams, those that hit a wall within
+        its 4 m range).
+    matches_recovered : int
+        Matches that ended within 1 cm and 0.2 degrees of the true pose.
+    match_many_speedup : float
+        Scans per second of one ``match_many`` call on every core over one on one thread.
+    odometry_rms_error : float
+        RMS position error of the odometry's poses against the simulator's truth [m].
+    map_cells : int
+        Occupied cells of the matched map.
+    map_bytes_per_cell : float
+        :meth:`ndtgrid.NdtGrid.memory_bytes` of that map over its cells.
+    machine : dict of str to str
+        Processor, cores, Python and ndtgrid versions.
+    """
+
+    rows: tuple[BenchRow, ...]
+    scans: int
+    points: int
+    matches_recovered: int
+    match_many_speedup: float
+    odometry_rms_error: float
+    map_cells: int
+    map_bytes_per_cell: float
+    machine: dict[str, str] = field(default_factory=dict)
+
+    def as_dict(self) -> dict[str, Any]:
+        """The report as plain values (for JSON).
+
+        Returns
+        -------
+        dict
+            Every attribute; ``rows`` as a list of dicts.
+        """
+        return asdict(self)
+
+    def table(self) -> str:
+        """The report as a Markdown table with a heading line.
+
+        Returns
+        -------
+        str
+            A line naming the machine and scans, then one table row per operation.
+        """
+        m = self.machine
+        lines = [
+            f"ndtgrid {m.get('ndtgrid', '?')} on {m.get('processor', '?')} "
+            f"({m.get('cores', '?')} cores), Python {m.get('python', '?')}: "
+            f"{self.scans} simulated URG-04LX scans of {self.points} points, "
+            f"2 cm cells ({self.map_cells} cells, {self.map_bytes_per_cell:.0f} B / cell).",
+            "",
+            "| operation | median | p90 | calls | checked |",
+            "|---|---:|---:|---:|---|",
+        ]
+        for r in self.rows:
+            p90 = "-" if r.p90 is None else f"{r.p90:.3f} {r.unit}"
+            lines.append(f"| {r.name} | {r.median:.3f} {r.unit} | {p90} | {r.calls} | {r.note} |")
+        return "\n".join(lines)
+
+
+def max_scans() -> int:
+    """The most scans :func:`run_bench` can take: the poses of the simulated tour.
+
+    Returns
+    -------
+    int
+        Poses of the sticks room's tour at 2 cm per scan.
+    """
+    return len(_tour())
+
+
+def _tour() -> F64:
+    """The simulated robot's true poses (the sticks room's tour, 2 cm per scan)."""
+    return sim.trajectory(sim.sticks_room().tour)
+
+
+def _machine() -> dict[str, str]:
+    """Processor, cores, Python and ndtgrid versions of this machine."""
+    name = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    name = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    return {
+        "processor": name,
+        "cores": str(cores),
+        "python": platform.python_version(),
+        "ndtgrid": __version__,
+        "platform": platform.platform(),
+    }
+
+
+def _row(name: str, unit: str, times_ns: list[int], note: str) -> BenchRow:
+    """A row from per-call times in nanoseconds, shown in ``unit``."""
+    scale = {"ms": 1e-6, "µs": 1e-3}[unit]
+    t = np.asarray(times_ns, dtype=np.float64) * scale
+    return BenchRow(name, unit, float(np.median(t)), float(np.percentile(t, 90)), len(t), note)
+
+
+def _guesses(truth: F64) -> F64:
+    """Each true pose moved by :data:`GUESS_OFFSET` in its own frame."""
+    dx, dy, dth = GUESS_OFFSET
+    c, s = np.cos(truth[:, 2]), np.sin(truth[:, 2])
+    return np.column_stack(
+        [truth[:, 0] + c * dx - s * dy, truth[:, 1] + s * dx + c * dy, truth[:, 2] + dth]
+    )
+
+
+def run_bench(
+    scans: int | None = None,
+    *,
+    seed: int = 0,
+    progress: Callable[[Iterable[Any], str, int], Iterator[Any]] | None = None,
+) -> BenchReport:
+    """Time insert, match, ``match_many`` and the odometry loop on simulated scans.
+
+    Parameters
+    ----------
+    scans : int, optional
+        Simulated scans, from :data:`MIN_SCANS` to :func:`max_scans` (the default: the
+        whole tour). A run takes about 5 ms per scan on a 2-core VM, most of it
+        simulating the laser.
+    seed : int, default 0
+        Seed of the laser's noise and the odometry's drift.
+    progress : callable, optional
+        ``progress(items, label, total)`` wraps the simulation's loop over the scans (the run's
+        longest part), e.g. to draw a progress bar; it must yield the items in order. The
+        timed loops run without it: a bar drawn between calls slowed them (inserts by a
+        third on a 2-core VM).
+
+    Returns
+    -------
+    BenchReport
+        The timings and what was checked.
+
+    Raises
+    ------
+    ValueError
+        If ``scans`` is out of range.
+    """
+    most = max_scans()
+    if scans is None:
+        scans = most
+    if isinstance(scans, bool) or not isinstance(scans, int) or not MIN_SCANS <= scans <= most:
+        raise ValueError(
+            f"scans: expected an integer from {MIN_SCANS} to {most} (the simulated tour's "
+            f"poses), got {scans!r}"
+        )
+
+    room = sim.sticks_room()
+    truth = _tour()[:scans]
+    stream: Iterable[F64] = sim.scan_ranges(room, sim.URG04LX, truth, seed=seed)
+    if progress is not None:
+        stream = progress(stream, "simulating", scans)
+    ranges = np.array(list(stream))
+    angles = sim.URG04LX.angles
+    points = [ranges_to_points(r, angles) for r in ranges]
+    rows: list[BenchRow] = []
+
+    grid = NdtGrid(CELL_SIZE)
+    insert_ns: list[int] = []
+    for i in range(scans):
+        if i > 0:
+            grid.match(points[i], truth[i])  # untimed: prepares the distributions
+        t0 = time.perf_counter_ns()
+        grid.insert(points[i], truth[i])
+        dt = time.perf_counter_ns() - t0
+        if i >= min(UNTIMED_INSERTS, scans // 2):
+            insert_ns.append(dt)
+    rows.append(_row("insert", "µs", insert_ns, f"map of up to {scans} scans"))
+
+    guesses = _guesses(truth)
+    match_ns: list[int] = []
+    recovered = 0
+    for i in range(scans):
+        t0 = time.perf_counter_ns()
+        res = grid.match(points[i], guesses[i])
+        match_ns.append(time.perf_counter_ns() - t0)
+        err_t, err_r = pose_error(res.pose, truth[i])
+        recovered += err_t <= RECOVERED[0] and err_r <= RECOVERED[1]
+    rows.append(
+        _row(
+            "match",
+            "ms",
+            match_ns,
+            f"{recovered} of {scans} within 1 cm and 0.2° of the truth",
+        )
+    )
+
+    many: dict[str, float] = {}
+    for label, threads in [("one thread", 1), ("every core", None)]:
+        t0 = time.perf_counter_ns()
+        grid.match_many(points, guesses, threads=threads)
+        many[label] = (time.perf_counter_ns() - t0) / scans
+    speedup = many["one thread"] / many["every core"]
+    for label, per_scan in many.items():
+        rows.append(
+            BenchRow(
+                f"match_many, {label}",
+                "ms",
+                per_scan * 1e-6,
+                None,
+                scans,
+                f"{1e9 / per_scan:.0f} scans / s"
+                + (f", {speedup:.2f} x one thread" if label == "every core" else ""),
+            )
+        )
+
+    odometry = sim.odometry(truth, drift=ODOMETRY_DRIFT, seed=seed)
+    odo = Odometry(cell_size=CELL_SIZE)
+    step_ns: list[int] = []
+    start = time.perf_counter_ns()
+    for i in range(scans):
+        t0 = time.perf_counter_ns()
+        odo.step(ranges[i], angles, odometry[i])
+        step_ns.append(time.perf_counter_ns() - t0)
+    _ = odo.mapper  # waits for the helper thread to take in the last scans
+    total = (time.perf_counter_ns() - start) * 1e-9
+    est = odo.poses
+    errors = [pose_error(_relative(est, i), _relative(truth, i))[0] for i in range(scans)]
+    rms = float(np.sqrt(np.mean(np.square(errors))))
+    rows.append(
+        _row(
+            "odometry step",
+            "ms",
+            step_ns,
+            f"{1e3 * total / scans:.3f} ms / scan with the map's helper; "
+            f"{100 * rms:.2f} cm RMS from the truth",
+        )
+    )
+
+    return BenchReport(
+        rows=tuple(rows),
+        scans=scans,
+        points=int(np.median([len(p) for p in points])),
+        matches_recovered=recovered,
+        match_many_speedup=speedup,
+        odometry_rms_error=rms,
+        map_cells=len(grid),
+        map_bytes_per_cell=grid.memory_bytes / max(len(grid), 1),
+        machine=_machine(),
+    )
+
+
+def _relative(poses: F64, i: int) -> F64:
+    """Pose ``i`` in the frame of pose 0 (the odometry starts its frame at its first
+    reading, the truth at the tour's start)."""
+    return np.asarray(se2.between(poses[0], poses[i]), dtype=np.float64)

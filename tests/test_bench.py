@@ -1,0 +1,161 @@
+"""``ndtgrid bench`` (:mod:`ndtgrid.bench`): what it times is checked work, its report and
+its command line.
+
+No time is asserted here (speed targets live in ``benches/``); what is asserted is that
+the run did the work it reports: every match recovered its pose, the odometry followed
+the truth, the map is the one the scans make, and the numbers are consistent."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable, Iterator
+from typing import Any
+
+import numpy as np
+import pytest
+
+from ndtgrid import NdtGrid, bench, ranges_to_points, sim
+from ndtgrid._progress import progress
+from ndtgrid.cli import main
+
+SCANS = 40
+
+
+@pytest.fixture(scope="module")
+def report() -> bench.BenchReport:
+    return bench.run_bench(SCANS, seed=2)
+
+
+def test_every_match_recovers_its_pose_and_the_odometry_follows_the_truth(
+    report: bench.BenchReport,
+) -> None:
+    assert report.scans == SCANS
+    assert report.matches_recovered == SCANS
+    rows = {r.name: r for r in report.rows}
+    assert rows["match"].note == f"{SCANS} of {SCANS} within 1 cm and 0.2° of the truth"
+    # 40 scans at 2 cm drive 0.8 m with 2 % odometry drift; matching keeps well under it.
+    assert 0.0 <= report.odometry_rms_error < 0.005
+    assert report.match_many_speedup > 0.0
+
+
+def test_rows_are_the_timed_operations_with_consistent_numbers(
+    report: bench.BenchReport,
+) -> None:
+    names = [r.name for r in report.rows]
+    assert names == [
+        "insert",
+        "match",
+        "match_many, one thread",
+        "match_many, every core",
+        "odometry step",
+    ]
+    calls = {r.name: r.calls for r in report.rows}
+    assert calls["insert"] == SCANS - bench.UNTIMED_INSERTS
+    assert all(calls[n] == SCANS for n in names[1:])
+    for r in report.rows:
+        assert r.median > 0.0, r.name
+        if r.name.startswith("match_many"):
+            assert r.p90 is None
+        else:
+            assert r.p90 is not None and r.p90 >= r.median, r.name
+    one, every = (r for r in report.rows if r.name.startswith("match_many"))
+    assert report.match_many_speedup == pytest.approx(one.median / every.median)
+
+
+def test_the_map_is_the_one_the_scans_make(report: bench.BenchReport) -> None:
+    room = sim.sticks_room()
+    truth = sim.trajectory(room.tour)[:SCANS]
+    ranges, angles = sim.simulate(room, sim.URG04LX, truth, seed=2)
+    grid = NdtGrid(bench.CELL_SIZE)
+    points = [ranges_to_points(r, angles) for r in ranges]
+    for i, (p, pose) in enumerate(zip(points, truth)):
+        if i > 0:
+            grid.match(p, pose)  # as the bench: distributions prepared before each insert
+        grid.insert(p, pose)
+    assert report.map_cells == len(grid)
+    assert report.map_bytes_per_cell == pytest.approx(grid.memory_bytes / len(grid))
+    assert report.points == int(np.median([len(p) for p in points]))
+
+
+def test_report_as_json_and_table(report: bench.BenchReport) -> None:
+    data = json.loads(json.dumps(report.as_dict()))
+    assert data["scans"] == SCANS and len(data["rows"]) == len(report.rows)
+    assert data["rows"][1]["name"] == "match"
+    assert set(data["machine"]) == {"processor", "cores", "python", "ndtgrid", "platform"}
+    table = report.table().splitlines()
+    assert table[0].startswith(f"ndtgrid {report.machine['ndtgrid']} on ")
+    assert f"{SCANS} simulated URG-04LX scans" in table[0]
+    assert table[2] == "| operation | median | p90 | calls | checked |"
+    assert len(table) == 4 + len(report.rows)
+    assert table[6].startswith("| match_many, one thread | ") and " | - | " in table[6]
+
+
+def test_progress_wraps_the_simulation_with_its_total() -> None:
+    seen: list[tuple[str, int, int]] = []
+
+    def spy(items: Iterable[Any], label: str, total: int) -> Iterator[Any]:
+        n = 0
+        for n, item in enumerate(items, start=1):
+            yield item
+        seen.append((label, total, n))
+
+    rep = bench.run_bench(bench.MIN_SCANS, progress=spy)
+    assert seen == [("simulating", bench.MIN_SCANS, bench.MIN_SCANS)]
+    assert rep.matches_recovered == bench.MIN_SCANS
+
+
+@pytest.mark.parametrize("bad", [bench.MIN_SCANS - 1, 0, -5, 10_000, 25.0, True, "30"])
+def test_scans_out_of_range_are_refused(bad: object) -> None:
+    most = bench.max_scans()
+    with pytest.raises(ValueError) as info:
+        bench.run_bench(bad)  # type: ignore[arg-type]
+    assert str(info.value) == (
+        f"scans: expected an integer from {bench.MIN_SCANS} to {most} (the simulated "
+        f"tour's poses), got {bad!r}"
+    )
+
+
+def test_max_scans_is_the_whole_tour() -> None:
+    assert bench.max_scans() == len(sim.trajectory(sim.sticks_room().tour))
+
+
+def test_cli_bench_table_json_and_errors(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["bench", "--scans", "20", "--quiet"]) == 0
+    captured = capsys.readouterr()
+    assert captured.err == ""
+    lines = captured.out.splitlines()
+    assert "20 simulated URG-04LX scans" in lines[0]
+    assert any(line.startswith("| match | ") for line in lines)
+    assert main(["bench", "--scans", "20", "--quiet", "--json", "--seed", "1"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["scans"] == 20 and data["matches_recovered"] == 20
+    assert main(["bench", "--scans", "5"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == (
+        f"ndtgrid bench: scans: expected an integer from {bench.MIN_SCANS} to "
+        f"{bench.max_scans()} (the simulated tour's poses), got 5\n"
+    )
+
+
+def test_plain_progress_counter_without_tqdm(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import sys
+
+    monkeypatch.setitem(sys.modules, "tqdm", None)  # import tqdm now fails
+    assert list(progress(range(1001), False, "mapping")) == list(range(1001))
+    err = capsys.readouterr().err
+    assert "\rmapping: 500 scans (" in err and "\rmapping: 1000 scans (" in err
+    assert err.endswith("\rmapping: 1001 scans\n")
+    assert list(progress(range(3), True, "mapping")) == [0, 1, 2]
+    assert capsys.readouterr().err == ""
+
+
+def test_scan_ranges_are_simulates_rows() -> None:
+    room = sim.sticks_room()
+    poses = sim.trajectory(room.tour)[100:130]
+    ranges, _ = sim.simulate(room, sim.URG04LX, poses, seed=5)
+    one_by_one = list(sim.scan_ranges(room, sim.URG04LX, poses, seed=5))
+    assert len(one_by_one) == len(poses)
+    np.testing.assert_array_equal(np.array(one_by_one), ranges)
