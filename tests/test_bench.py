@@ -23,7 +23,7 @@ SCANS = 40
 
 @pytest.fixture(scope="module")
 def report() -> bench.BenchReport:
-    return bench.run_bench(SCANS, seed=2)
+    return bench.run_bench(SCANS, seed=2, repeats=3)
 
 
 def test_every_match_recovers_its_pose_and_the_odometry_follows_the_truth(
@@ -35,7 +35,7 @@ def test_every_match_recovers_its_pose_and_the_odometry_follows_the_truth(
     assert rows["match"].note == f"{SCANS} of {SCANS} within 1 cm and 0.2° of the truth"
     # 40 scans at 2 cm drive 0.8 m with 2 % odometry drift; matching keeps well under it.
     assert 0.0 <= report.odometry_rms_error < 0.005
-    assert report.match_many_speedup > 0.0
+    assert report.match_many_speedup > 0.0 and report.python_threads_speedup > 0.0
 
 
 def test_rows_are_the_timed_operations_with_consistent_numbers(
@@ -47,19 +47,32 @@ def test_rows_are_the_timed_operations_with_consistent_numbers(
         "match",
         "match_many, one thread",
         "match_many, every core",
+        "match, 1 Python thread",
+        "match, 2 Python threads",
         "odometry step",
     ]
     calls = {r.name: r.calls for r in report.rows}
     assert calls["insert"] == SCANS - bench.UNTIMED_INSERTS
     assert all(calls[n] == SCANS for n in names[1:])
+    batches = {n for n in names if n.startswith("match_many") or "Python" in n}
     for r in report.rows:
         assert r.median > 0.0, r.name
-        if r.name.startswith("match_many"):
-            assert r.p90 is None
+        if r.name in batches:
+            assert r.p90 is None, r.name
         else:
             assert r.p90 is not None and r.p90 >= r.median, r.name
-    one, every = (r for r in report.rows if r.name.startswith("match_many"))
-    assert report.match_many_speedup == pytest.approx(one.median / every.median)
+    rows = {r.name: r for r in report.rows}
+    for first, other, speedup in [
+        ("match_many, one thread", "match_many, every core", report.match_many_speedup),
+        ("match, 1 Python thread", "match, 2 Python threads", report.python_threads_speedup),
+    ]:
+        assert speedup == pytest.approx(rows[first].median / rows[other].median)
+        rate = float(rows[first].note.removesuffix(" scans / s, median of 3 runs"))
+        assert rate == pytest.approx(1e3 / rows[first].median, abs=0.5)
+        label = first.split(", ")[1]
+        lo, hi = map(float, rows[other].note.split("(")[1].removesuffix(" by round)").split(" to "))
+        assert lo <= hi
+        assert f"; {speedup:.2f} x {label} (" in rows[other].note
 
 
 def test_the_map_is_the_one_the_scans_make(report: bench.BenchReport) -> None:
@@ -88,16 +101,16 @@ def test_report_as_json_and_table(report: bench.BenchReport) -> None:
     assert table[2] == "| operation | median | p90 | calls | checked |"
     assert len(table) == 4 + len(report.rows)
     assert table[6].startswith("| match_many, one thread | ") and " | - | " in table[6]
+    assert table[8].startswith("| match, 1 Python thread | ")
 
 
 def test_progress_wraps_the_simulation_with_its_total() -> None:
     seen: list[tuple[str, int, int]] = []
 
     def spy(items: Iterable[Any], label: str, total: int) -> Iterator[Any]:
-        n = 0
-        for n, item in enumerate(items, start=1):
-            yield item
-        seen.append((label, total, n))
+        got = list(items)
+        yield from got
+        seen.append((label, total, len(got)))
 
     rep = bench.run_bench(bench.MIN_SCANS, progress=spy)
     assert seen == [("simulating", bench.MIN_SCANS, bench.MIN_SCANS)]
@@ -113,6 +126,13 @@ def test_scans_out_of_range_are_refused(bad: object) -> None:
         f"scans: expected an integer from {bench.MIN_SCANS} to {most} (the simulated "
         f"tour's poses), got {bad!r}"
     )
+
+
+@pytest.mark.parametrize("bad", [0, -1, 2.0, True, None])
+def test_repeats_below_one_are_refused(bad: object) -> None:
+    with pytest.raises(ValueError) as info:
+        bench.run_bench(SCANS, repeats=bad)  # type: ignore[arg-type]
+    assert str(info.value) == f"repeats: expected an integer >= 1, got {bad!r}"
 
 
 def test_max_scans_is_the_whole_tour() -> None:

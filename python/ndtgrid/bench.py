@@ -16,6 +16,9 @@ What is timed, one call at a time on the calling thread (wall clock,
   true pose moved by 3 cm, -2 cm and 1 degree.
 - ``match_many``: the same matches in one :meth:`~ndtgrid.NdtGrid.match_many` call, on one
   thread and then on every core.
+- ``match, N Python threads``: the same matches by one, then two Python threads started
+  together, each calling :meth:`~ndtgrid.NdtGrid.match` for every other scan (the GIL is
+  released during a match).
 - ``odometry``: :meth:`ndtgrid.Odometry.step` over the scans with drifting odometry, the
   whole SLAM front end (matching, its own grid's upkeep, and the §V map on a helper
   thread, waited for at the end).
@@ -29,9 +32,11 @@ from __future__ import annotations
 import math
 import os
 import platform
+import threading
 import time
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import asdict, dataclass, field
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -105,7 +110,11 @@ class BenchReport:
     matches_recovered : int
         Matches that ended within 1 cm and 0.2 degrees of the true pose.
     match_many_speedup : float
-        Scans per second of one ``match_many`` call on every core over one on one thread.
+        Scans per second of one ``match_many`` call on every core over one on one thread
+        (median rounds).
+    python_threads_speedup : float
+        Scans per second of two Python threads calling ``match`` over one such thread
+        (median rounds).
     odometry_rms_error : float
         RMS position error of the odometry's poses against the simulator's truth [m].
     map_cells : int
@@ -121,6 +130,7 @@ class BenchReport:
     points: int
     matches_recovered: int
     match_many_speedup: float
+    python_threads_speedup: float
     odometry_rms_error: float
     map_cells: int
     map_bytes_per_cell: float
@@ -204,6 +214,61 @@ def _row(name: str, unit: str, times_ns: list[int], note: str) -> BenchRow:
     return BenchRow(name, unit, float(np.median(t)), float(np.percentile(t, 90)), len(t), note)
 
 
+def _batches(timers: dict[str, Callable[[], int]], repeats: int) -> dict[str, list[int]]:
+    """Each timer's nanoseconds over ``repeats`` rounds, the timers taking turns in each
+    round (so a slow spell of the machine falls on all of them)."""
+    runs: dict[str, list[int]] = {label: [] for label in timers}
+    for _ in range(repeats):
+        for label, timer in timers.items():
+            runs[label].append(timer())
+    return runs
+
+
+def _batch_rows(name: str, runs: dict[str, list[int]], scans: int) -> list[BenchRow]:
+    """Rows of batches of ``scans`` scans timed as a whole (``label: ns per run``): the
+    median run per scan; the first label is the baseline of the others' speed-ups (the
+    ratio of the medians, and its range over the rounds)."""
+    first, base = next(iter(runs.items()))
+    rows = []
+    for k, (label, ns) in enumerate(runs.items()):
+        per_scan = float(np.median(ns)) / scans
+        note = f"{1e9 / per_scan:.0f} scans / s, median of {len(ns)} runs"
+        if k:
+            ratios = np.divide(base, ns)
+            note += (
+                f"; {float(np.median(base)) / float(np.median(ns)):.2f} x {first} "
+                f"({ratios.min():.2f} to {ratios.max():.2f} by round)"
+            )
+        rows.append(BenchRow(f"{name}, {label}", "ms", per_scan * 1e-6, None, scans, note))
+    return rows
+
+
+def _speedup(base: list[int], other: list[int]) -> float:
+    """The ratio of the median times of two batches."""
+    return float(np.median(base)) / float(np.median(other))
+
+
+def _threads_ns(grid: NdtGrid, points: list[F64], guesses: F64, threads: int) -> int:
+    """Nanoseconds ``threads`` Python threads, started together, take to match every scan
+    (scan ``i`` on thread ``i mod threads``), one :meth:`~ndtgrid.NdtGrid.match` call
+    after the other; the clock runs from their start to the last one's end."""
+    start = threading.Barrier(threads + 1)
+
+    def work(k: int) -> None:
+        start.wait()
+        for i in range(k, len(points), threads):
+            grid.match(points[i], guesses[i])
+
+    workers = [threading.Thread(target=work, args=(k,)) for k in range(threads)]
+    for w in workers:
+        w.start()
+    start.wait()
+    t0 = time.perf_counter_ns()
+    for w in workers:
+        w.join()
+    return time.perf_counter_ns() - t0
+
+
 def _guesses(truth: F64) -> F64:
     """Each true pose moved by :data:`GUESS_OFFSET` in its own frame."""
     dx, dy, dth = GUESS_OFFSET
@@ -217,6 +282,7 @@ def run_bench(
     scans: int | None = None,
     *,
     seed: int = 0,
+    repeats: int = 5,
     progress: Callable[[Iterable[Any], str, int], Iterator[Any]] | None = None,
 ) -> BenchReport:
     """Time insert, match, ``match_many`` and the odometry loop on simulated scans.
@@ -229,6 +295,9 @@ def run_bench(
         simulating the laser.
     seed : int, default 0
         Seed of the laser's noise and the odometry's drift.
+    repeats : int, default 5
+        Rounds of the batches timed as a whole (``match_many`` and the Python threads),
+        which take turns in each round; their rows give the median round. At least 1.
     progress : callable, optional
         ``progress(items, label, total)`` wraps the simulation's loop over the scans (the run's
         longest part), e.g. to draw a progress bar; it must yield the items in order. The
@@ -243,9 +312,11 @@ def run_bench(
     Raises
     ------
     ValueError
-        If ``scans`` is out of range.
+        If ``scans`` or ``repeats`` is out of range.
     """
     most = max_scans()
+    if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
+        raise ValueError(f"repeats: expected an integer >= 1, got {repeats!r}")
     if scans is None:
         scans = most
     if isinstance(scans, bool) or not isinstance(scans, int) or not MIN_SCANS <= scans <= most:
@@ -294,24 +365,26 @@ def run_bench(
         )
     )
 
-    many: dict[str, float] = {}
-    for label, threads in [("one thread", 1), ("every core", None)]:
-        t0 = time.perf_counter_ns()
-        grid.match_many(points, guesses, threads=threads)
-        many[label] = (time.perf_counter_ns() - t0) / scans
-    speedup = many["one thread"] / many["every core"]
-    for label, per_scan in many.items():
-        rows.append(
-            BenchRow(
-                f"match_many, {label}",
-                "ms",
-                per_scan * 1e-6,
-                None,
-                scans,
-                f"{1e9 / per_scan:.0f} scans / s"
-                + (f", {speedup:.2f} x one thread" if label == "every core" else ""),
+    def many(threads: int | None) -> Callable[[], int]:
+        def run() -> int:
+            t0 = time.perf_counter_ns()
+            grid.match_many(points, guesses, threads=threads)
+            return time.perf_counter_ns() - t0
+
+        return run
+
+    many_runs = _batches({"one thread": many(1), "every core": many(None)}, repeats)
+    rows += _batch_rows("match_many", many_runs, scans)
+    python_runs = _batches(
+        {
+            f"{n} Python thread{'s' if n > 1 else ''}": partial(
+                _threads_ns, grid, points, guesses, n
             )
-        )
+            for n in (1, 2)
+        },
+        repeats,
+    )
+    rows += _batch_rows("match", python_runs, scans)
 
     odometry = sim.odometry(truth, drift=ODOMETRY_DRIFT, seed=seed)
     odo = Odometry(cell_size=CELL_SIZE)
@@ -341,7 +414,10 @@ def run_bench(
         scans=scans,
         points=int(np.median([len(p) for p in points])),
         matches_recovered=recovered,
-        match_many_speedup=speedup,
+        match_many_speedup=_speedup(many_runs["one thread"], many_runs["every core"]),
+        python_threads_speedup=_speedup(
+            python_runs["1 Python thread"], python_runs["2 Python threads"]
+        ),
         odometry_rms_error=rms,
         map_cells=len(grid),
         map_bytes_per_cell=grid.memory_bytes / max(len(grid), 1),

@@ -104,6 +104,13 @@ def build_parser() -> argparse.ArgumentParser:
         f"{bench.max_scans()} poses of the simulated tour)",
     )
     b.add_argument("--seed", type=int, default=0, help="simulation seed (0)")
+    b.add_argument(
+        "--repeats",
+        type=int,
+        default=5,
+        help="rounds of the batches timed as a whole (match_many, Python threads); "
+        "their median is shown (5)",
+    )
     b.add_argument("--json", action="store_true", help="print the report as JSON")
     b.add_argument("--quiet", action="store_true", help="no progress bars")
     e = sub.add_parser(
@@ -277,7 +284,7 @@ def run_bench(args: argparse.Namespace) -> int:
         return progress(items, args.quiet, label, total=total)
 
     try:
-        report = bench.run_bench(args.scans, seed=args.seed, progress=bars)
+        report = bench.run_bench(args.scans, seed=args.seed, repeats=args.repeats, progress=bars)
     except ValueError as err:
         print(f"ndtgrid bench: {err}", file=sys.stderr)
         return 2
