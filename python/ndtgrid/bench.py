@@ -301,8 +301,7 @@ def run_bench(
     progress : callable, optional
         ``progress(items, label, total)`` wraps the simulation's loop over the scans (the run's
         longest part), e.g. to draw a progress bar; it must yield the items in order. The
-        timed loops run without it: a bar drawn between calls slowed them (inserts by a
-        third on a 2-core VM).
+        timed loops run without it, so that no drawing falls between the timed calls.
 
     Returns
     -------
