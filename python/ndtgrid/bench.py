@@ -5,8 +5,8 @@ The scans are simulated (the paper's sticks room seen by a URG-04LX, 683 beams, 
 comes with a check that the work was done right: matches must recover the true pose,
 and the odometry's error against the simulator's truth is reported beside its speed.
 
-What is timed, one call at a time on the calling thread (wall clock,
-:func:`time.perf_counter_ns`), Python's call overhead included:
+What is timed (wall clock, :func:`time.perf_counter_ns`, Python's call overhead
+included; one call at a time on the calling thread unless said otherwise):
 
 - ``insert``: :meth:`ndtgrid.NdtGrid.insert` of each scan at its true pose into a 2 cm map
   that holds the scans before it. As in a SLAM loop, the map's distributions are prepared
@@ -285,7 +285,8 @@ def run_bench(
     repeats: int = 5,
     progress: Callable[[Iterable[Any], str, int], Iterator[Any]] | None = None,
 ) -> BenchReport:
-    """Time insert, match, ``match_many`` and the odometry loop on simulated scans.
+    """Time insert, match (alone, by ``match_many`` and from Python threads) and the
+    odometry loop on simulated scans.
 
     Parameters
     ----------
