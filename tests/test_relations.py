@@ -70,3 +70,37 @@ def test_associate_takes_the_nearest_time_within_the_gap() -> None:
     np.testing.assert_array_equal(associate(times, [1.4, 1.6], max_dt=0.5), [1, 2])
     with pytest.raises(ValueError, match="non-decreasing"):
         associate([1.0, 0.0], [0.0], max_dt=1.0)
+
+
+def test_anchored_errors_ignore_where_each_trajectory_starts() -> None:
+    from ndtgrid.evaluation import anchored_errors
+
+    rng = np.random.default_rng(4)
+    ref = np.cumsum(rng.normal(0.0, 0.1, size=(30, 3)), axis=0)
+    # The same motion seen from another frame: no error at any pose.
+    moved = np.array([se2.compose([2.0, -1.0, 0.7], p) for p in ref])
+    np.testing.assert_allclose(anchored_errors(moved, ref), 0.0, atol=1e-12)
+    # An estimate that is off by 5 cm sideways (in the anchored frame) from pose 10 on.
+    anchored = np.array([se2.between(ref[0], p) for p in ref])
+    off = anchored.copy()
+    off[10:, 1] += 0.05
+    est = np.array([se2.compose(moved[0], p) for p in off])
+    errors = anchored_errors(est, ref)
+    np.testing.assert_allclose(errors[:10], 0.0, atol=1e-12)
+    np.testing.assert_allclose(errors[10:], 0.05, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("estimate", "reference"),
+    [(np.zeros((4, 3)), np.zeros((5, 3))), (np.zeros((4, 2)), np.zeros((4, 2))), ([], [])],
+)
+def test_anchored_errors_check_shapes(estimate: object, reference: object) -> None:
+    from ndtgrid.evaluation import anchored_errors
+
+    e, r = np.asarray(estimate, dtype=float), np.asarray(reference, dtype=float)
+    with pytest.raises(ValueError) as info:
+        anchored_errors(estimate, reference)  # type: ignore[arg-type]
+    assert str(info.value) == (
+        "estimate, reference: expected two (T, 3) arrays of the same T >= 1, got "
+        f"{e.shape} and {r.shape}"
+    )

@@ -42,9 +42,9 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ndtgrid import __version__, se2, sim
+from ndtgrid import __version__, sim
 from ndtgrid._core import NdtGrid, ranges_to_points
-from ndtgrid.evaluation import pose_error
+from ndtgrid.evaluation import anchored_errors, pose_error
 from ndtgrid.odometry import Odometry
 
 __all__ = ["MIN_SCANS", "BenchReport", "BenchRow", "max_scans", "run_bench"]
@@ -396,9 +396,7 @@ def run_bench(
         step_ns.append(time.perf_counter_ns() - t0)
     _ = odo.mapper  # waits for the helper thread to take in the last scans
     total = (time.perf_counter_ns() - start) * 1e-9
-    est = odo.poses
-    errors = [pose_error(_relative(est, i), _relative(truth, i))[0] for i in range(scans)]
-    rms = float(np.sqrt(np.mean(np.square(errors))))
+    rms = float(np.sqrt(np.mean(np.square(anchored_errors(odo.poses, truth)))))
     rows.append(
         _row(
             "odometry step",
@@ -423,9 +421,3 @@ def run_bench(
         map_bytes_per_cell=grid.memory_bytes / max(len(grid), 1),
         machine=_machine(),
     )
-
-
-def _relative(poses: F64, i: int) -> F64:
-    """Pose ``i`` in the frame of pose 0 (the odometry starts its frame at its first
-    reading, the truth at the tour's start)."""
-    return np.asarray(se2.between(poses[0], poses[i]), dtype=np.float64)

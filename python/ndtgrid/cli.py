@@ -231,7 +231,8 @@ def run_map(args: argparse.Namespace) -> int:
 
 def run_demo(args: argparse.Namespace) -> int:
     """``ndtgrid demo``: see :func:`build_parser`."""
-    from ndtgrid import se2, sim
+    from ndtgrid import sim
+    from ndtgrid.evaluation import anchored_errors
 
     room = sim.sticks_room()
     truth = sim.trajectory(room.tour, step=0.05)
@@ -262,11 +263,8 @@ def run_demo(args: argparse.Namespace) -> int:
     odo, _ = done
     # Both trajectories start at the first pose (the odometry's frame is the first
     # odometry reading); compare in that frame.
-    est = np.array([se2.between(odo.poses[0], p) for p in odo.poses])
-    ref = np.array([se2.between(truth[0], p) for p in truth])
-    err = np.hypot(*(est[:, :2] - ref[:, :2]).T)
-    drift = np.array([se2.between(odom[0], p) for p in odom])
-    odo_err = np.hypot(*(drift[:, :2] - ref[:, :2]).T)
+    err = anchored_errors(odo.poses, truth)
+    odo_err = anchored_errors(odom, truth)
     objects = odo.mapper.small_objects()
     print(
         f"pose error against the truth: {100 * np.sqrt(np.mean(err**2)):.2f} cm RMS, "

@@ -20,6 +20,7 @@ __all__ = [
     "RelationErrors",
     "RelationSummary",
     "ScanPair",
+    "anchored_errors",
     "associate",
     "corrected_pairs",
     "pose_error",
@@ -46,6 +47,39 @@ def pose_error(estimate: npt.ArrayLike, reference: npt.ArrayLike) -> tuple[float
     """
     d = se2.between(reference, estimate)
     return float(np.hypot(d[0], d[1])), float(abs(d[2]))
+
+
+def anchored_errors(estimate: npt.ArrayLike, reference: npt.ArrayLike) -> F64:
+    """Position error of each pose once both trajectories start at their own first pose.
+
+    For an odometry whose frame is its first reading: both trajectories are expressed
+    in the frame of their first pose (``first^-1 o pose``), then compared pose by pose.
+
+    Parameters
+    ----------
+    estimate, reference : array_like, shape (T, 3)
+        Poses ``[x, y, theta]`` (m, m, rad), row ``i`` of each for the same time.
+
+    Returns
+    -------
+    ndarray, shape (T,)
+        Distance between the anchored positions [m] (0 for the first pose).
+
+    Raises
+    ------
+    ValueError
+        If the two are not (T, 3) arrays of the same length, T >= 1.
+    """
+    est = np.asarray(estimate, dtype=np.float64)
+    ref = np.asarray(reference, dtype=np.float64)
+    if est.ndim != 2 or est.shape[1:] != (3,) or est.shape != ref.shape or len(est) == 0:
+        raise ValueError(
+            "estimate, reference: expected two (T, 3) arrays of the same T >= 1, got "
+            f"{est.shape} and {ref.shape}"
+        )
+    a = np.array([se2.between(est[0], p) for p in est])
+    b = np.array([se2.between(ref[0], p) for p in ref])
+    return np.asarray(np.hypot(*(a[:, :2] - b[:, :2]).T), dtype=np.float64)
 
 
 @dataclass(frozen=True, eq=False)
