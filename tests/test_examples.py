@@ -8,6 +8,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 import ndtgrid
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -69,3 +71,18 @@ def test_demo_maps_the_simulated_room(tmp_path: Path, capsys: object) -> None:
     rms, worst, odometry = (float(m.group(i)) for i in (1, 2, 3))
     assert rms < 1.0 and worst < 2.0 and worst < odometry / 3
     assert int(m.group(4)) >= 8
+
+
+def test_demo_shows_progress_while_simulating_and_mapping(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from ndtgrid import sim
+    from ndtgrid.cli import main
+
+    monkeypatch.setitem(sys.modules, "tqdm", None)  # the plain counter: predictable text
+    assert main(["demo", "--out", str(tmp_path)]) == 0
+    err = capsys.readouterr().err
+    n = len(sim.trajectory(sim.sticks_room().tour, step=0.05))
+    assert f"\rsimulating: {n} scans\n" in err
+    assert f"\rmapping: {n} scans\n" in err
+    assert err.index("simulating") < err.index("mapping")

@@ -237,7 +237,9 @@ def run_demo(args: argparse.Namespace) -> int:
     room = sim.sticks_room()
     truth = sim.trajectory(room.tour, step=0.05)
     odom = sim.odometry(truth, drift=0.02, seed=args.seed)
-    ranges, angles = sim.simulate(room, sim.URG04LX, truth, seed=args.seed)
+    stream = sim.scan_ranges(room, sim.URG04LX, truth, seed=args.seed)
+    ranges = list(progress(stream, args.quiet, "simulating", total=len(truth)))
+    angles = sim.URG04LX.angles
     scans = [
         Scan(
             timestamp=0.1 * k,
