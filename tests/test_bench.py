@@ -94,6 +94,8 @@ def test_report_as_json_and_table(report: bench.BenchReport) -> None:
     data = json.loads(json.dumps(report.as_dict()))
     assert data["scans"] == SCANS and len(data["rows"]) == len(report.rows)
     assert data["rows"][1]["name"] == "match"
+    assert data["match_many_speedup"] == report.match_many_speedup
+    assert data["python_threads_speedup"] == report.python_threads_speedup
     assert set(data["machine"]) == {"processor", "cores", "python", "ndtgrid", "platform"}
     table = report.table().splitlines()
     assert table[0].startswith(f"ndtgrid {report.machine['ndtgrid']} on ")

@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ndtgrid import __version__, sim
+from ndtgrid import __version__, se2, sim
 from ndtgrid._core import NdtGrid, ranges_to_points
 from ndtgrid.evaluation import anchored_errors, pose_error
 from ndtgrid.odometry import Odometry
@@ -109,12 +109,6 @@ class BenchReport:
         its 4 m range).
     matches_recovered : int
         Matches that ended within 1 cm and 0.2 degrees of the true pose.
-    match_many_speedup : float
-        Scans per second of one ``match_many`` call on every core over one on one thread
-        (median rounds).
-    python_threads_speedup : float
-        Scans per second of two Python threads calling ``match`` over one such thread
-        (median rounds).
     odometry_rms_error : float
         RMS position error of the odometry's poses against the simulator's truth [m].
     map_cells : int
@@ -129,12 +123,44 @@ class BenchReport:
     scans: int
     points: int
     matches_recovered: int
-    match_many_speedup: float
-    python_threads_speedup: float
     odometry_rms_error: float
     map_cells: int
     map_bytes_per_cell: float
     machine: dict[str, str] = field(default_factory=dict)
+
+    def speedup(self, first: str, other: str) -> float:
+        """How many times faster row ``other`` ran than row ``first`` (ratio of their
+        medians).
+
+        Parameters
+        ----------
+        first, other : str
+            Row names (:attr:`BenchRow.name`).
+
+        Returns
+        -------
+        float
+            ``first``'s median time over ``other``'s.
+
+        Raises
+        ------
+        KeyError
+            If the report has no row of either name.
+        """
+        rows = {r.name: r for r in self.rows}
+        return rows[first].median / rows[other].median
+
+    @property
+    def match_many_speedup(self) -> float:
+        """Scans per second of one ``match_many`` call on every core over one on one
+        thread (median rounds)."""
+        return self.speedup("match_many, one thread", "match_many, every core")
+
+    @property
+    def python_threads_speedup(self) -> float:
+        """Scans per second of two Python threads calling ``match`` over one such thread
+        (median rounds)."""
+        return self.speedup("match, 1 Python thread", "match, 2 Python threads")
 
     def as_dict(self) -> dict[str, Any]:
         """The report as plain values (for JSON).
@@ -142,9 +168,14 @@ class BenchReport:
         Returns
         -------
         dict
-            Every attribute; ``rows`` as a list of dicts.
+            Every attribute (``rows`` as a list of dicts), and the two speed-ups
+            ``match_many_speedup`` and ``python_threads_speedup``.
         """
-        return asdict(self)
+        return {
+            **asdict(self),
+            "match_many_speedup": self.match_many_speedup,
+            "python_threads_speedup": self.python_threads_speedup,
+        }
 
     def table(self) -> str:
         """The report as a Markdown table with a heading line.
@@ -178,12 +209,12 @@ def max_scans() -> int:
     int
         Poses of the sticks room's tour at 2 cm per scan.
     """
-    return len(_tour())
+    return len(_tour(sim.sticks_room()))
 
 
-def _tour() -> F64:
-    """The simulated robot's true poses (the sticks room's tour, 2 cm per scan)."""
-    return sim.trajectory(sim.sticks_room().tour)
+def _tour(room: sim.World) -> F64:
+    """The simulated robot's true poses (``room``'s tour, 2 cm per scan)."""
+    return sim.trajectory(room.tour)
 
 
 def _machine() -> dict[str, str]:
@@ -229,23 +260,19 @@ def _batch_rows(name: str, runs: dict[str, list[int]], scans: int) -> list[Bench
     median run per scan; the first label is the baseline of the others' speed-ups (the
     ratio of the medians, and its range over the rounds)."""
     first, base = next(iter(runs.items()))
+    base_ms = float(np.median(base)) / scans * 1e-6
     rows = []
     for k, (label, ns) in enumerate(runs.items()):
-        per_scan = float(np.median(ns)) / scans
-        note = f"{1e9 / per_scan:.0f} scans / s, median of {len(ns)} runs"
+        ms = float(np.median(ns)) / scans * 1e-6
+        note = f"{1e3 / ms:.0f} scans / s, median of {len(ns)} runs"
         if k:
             ratios = np.divide(base, ns)
             note += (
-                f"; {float(np.median(base)) / float(np.median(ns)):.2f} x {first} "
+                f"; {base_ms / ms:.2f} x {first} "
                 f"({ratios.min():.2f} to {ratios.max():.2f} by round)"
             )
-        rows.append(BenchRow(f"{name}, {label}", "ms", per_scan * 1e-6, None, scans, note))
+        rows.append(BenchRow(f"{name}, {label}", "ms", ms, None, scans, note))
     return rows
-
-
-def _speedup(base: list[int], other: list[int]) -> float:
-    """The ratio of the median times of two batches."""
-    return float(np.median(base)) / float(np.median(other))
 
 
 def _threads_ns(grid: NdtGrid, points: list[F64], guesses: F64, threads: int) -> int:
@@ -270,12 +297,8 @@ def _threads_ns(grid: NdtGrid, points: list[F64], guesses: F64, threads: int) ->
 
 
 def _guesses(truth: F64) -> F64:
-    """Each true pose moved by :data:`GUESS_OFFSET` in its own frame."""
-    dx, dy, dth = GUESS_OFFSET
-    c, s = np.cos(truth[:, 2]), np.sin(truth[:, 2])
-    return np.column_stack(
-        [truth[:, 0] + c * dx - s * dy, truth[:, 1] + s * dx + c * dy, truth[:, 2] + dth]
-    )
+    """Each true pose moved by :data:`GUESS_OFFSET` in its own frame (``pose o offset``)."""
+    return np.array([se2.compose(t, GUESS_OFFSET) for t in truth], dtype=np.float64)
 
 
 def run_bench(
@@ -314,7 +337,9 @@ def run_bench(
     ValueError
         If ``scans`` or ``repeats`` is out of range.
     """
-    most = max_scans()
+    room = sim.sticks_room()
+    tour = _tour(room)
+    most = len(tour)
     if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
         raise ValueError(f"repeats: expected an integer >= 1, got {repeats!r}")
     if scans is None:
@@ -325,8 +350,7 @@ def run_bench(
             f"poses), got {scans!r}"
         )
 
-    room = sim.sticks_room()
-    truth = _tour()[:scans]
+    truth = tour[:scans]
     stream: Iterable[F64] = sim.scan_ranges(room, sim.URG04LX, truth, seed=seed)
     if progress is not None:
         stream = progress(stream, "simulating", scans)
@@ -412,10 +436,6 @@ def run_bench(
         scans=scans,
         points=int(np.median([len(p) for p in points])),
         matches_recovered=recovered,
-        match_many_speedup=_speedup(many_runs["one thread"], many_runs["every core"]),
-        python_threads_speedup=_speedup(
-            python_runs["1 Python thread"], python_runs["2 Python threads"]
-        ),
         odometry_rms_error=rms,
         map_cells=len(grid),
         map_bytes_per_cell=grid.memory_bytes / max(len(grid), 1),

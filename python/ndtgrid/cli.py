@@ -88,6 +88,7 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--out", default="demo-out", help="output directory (default: demo-out)")
     d.add_argument("--seed", type=int, default=0, help="simulation seed (0)")
     d.add_argument("--quiet", action="store_true", help="no progress bar")
+    most_scans = bench.max_scans()
     b = sub.add_parser(
         "bench",
         help="time insert, match and the odometry loop on this machine (no data needed)",
@@ -100,8 +101,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--scans",
         type=int,
         default=None,
-        help=f"simulated scans, {bench.MIN_SCANS} to {bench.max_scans()} (default: all "
-        f"{bench.max_scans()} poses of the simulated tour)",
+        help=f"simulated scans, {bench.MIN_SCANS} to {most_scans} (default: all "
+        f"{most_scans} poses of the simulated tour)",
     )
     b.add_argument("--seed", type=int, default=0, help="simulation seed (0)")
     b.add_argument(

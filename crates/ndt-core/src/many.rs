@@ -80,7 +80,7 @@ impl NdtGrid {
         }
         // Checked above: each scan is not checked again.
         let one = |i: usize| match phases {
-            Some(phases) => self.match_phased(scans[i], guesses[i], options, phases),
+            Some(phases) => self.phased_checked(scans[i], guesses[i], options, phases, levels),
             None => self.match_checked(scans[i], guesses[i], options, levels),
         };
         let threads = threads.unwrap_or_else(cores);

@@ -933,6 +933,23 @@ impl NdtGrid {
         phases: &[f64],
     ) -> Result<MatchResult> {
         check_phases(options, phases)?;
+        self.check_scan(points, guess)?;
+        let levels = self.match_levels(options)?;
+        self.phased_checked(points, guess, options, phases, levels)
+    }
+
+    /// [`NdtGrid::match_phased`] once its input is checked
+    /// ([`check_phases`] and [`NdtGrid::check_scan`] passed) on `levels`
+    /// levels ([`NdtGrid::match_levels`]): the points do not change from one
+    /// phase to the next, so only each phase's start is checked again.
+    pub(crate) fn phased_checked(
+        &self,
+        points: &[[f64; 2]],
+        guess: Pose2,
+        options: &MatchOptions,
+        phases: &[f64],
+        levels: usize,
+    ) -> Result<MatchResult> {
         let mut pose = guess;
         let mut iterations = 0;
         let mut last = None;
@@ -941,7 +958,8 @@ impl NdtGrid {
                 expansion: k,
                 ..*options
             };
-            let res = self.match_scan(points, pose, &opts)?;
+            check_finite("guess", &pose.to_array())?;
+            let res = self.match_checked(points, pose, &opts, levels)?;
             iterations += res.iterations;
             pose = res.pose;
             last = Some(res);
