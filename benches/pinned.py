@@ -32,6 +32,25 @@ def two_cpus() -> list[int] | None:
     return cpus[:2] if len(cpus) >= 2 else None
 
 
+def current_cpu() -> int | None:
+    """The CPU the calling thread is running on, or ``None`` where that cannot be read.
+
+    Field 39 (``processor``) of ``/proc/self/task/<tid>/stat`` (Linux); read by the
+    thread itself, it is the CPU the thread runs on at that moment. The thread section
+    of ``benches/speed.py`` reads it once per thread, half-way through each two-thread
+    run, to tell runs in which the kernel kept both threads on one vCPU.
+    """
+    try:
+        with open(f"/proc/self/task/{threading.get_native_id()}/stat") as f:
+            stat = f.read()
+    except OSError:
+        return None
+    # Field 2, the command, is in parentheses and may hold spaces or ")": the fields
+    # after the last ")" are 3, 4, ..., so field 39 is the 37th of them.
+    fields = stat.rsplit(")", 1)[-1].split()
+    return int(fields[36]) if len(fields) > 36 else None
+
+
 class PinnedWorkers:
     """One thread per CPU of ``cpus``, each pinned to it, started at once and kept until
     :meth:`close` (or the end of a ``with`` block).

@@ -33,7 +33,8 @@ as a Markdown table to stdout as soon as it is measured (progress goes to stderr
    (``benches/pinned.py``); the same scans in one ``NdtGrid.match_many`` call on one
    thread and on every core; two GIL-free controls in the same run (SHA-256, and our
    matcher on bundles of 20 scans merged into one, whose calls are long enough that the
-   GIL hardly matters); each run's ratios and late starts in
+   GIL hardly matters); in how many runs the kernel had both unpinned threads on one
+   vCPU half-way through; each run's ratios and late starts in
    ``docs/img/speed_threads.png`` when matplotlib is installed.
 6. **Memory**: bytes per occupied fine cell (RSS growth of a fresh child process divided by
    ``len(grid)``) before and after the distributions are built.
@@ -1289,15 +1290,16 @@ def plot_sweeps(res: dict[str, Any], path: Path) -> None:
 
 def plot_threads(runs: dict[str, list[float]], path: Path) -> None:
     """The thread section's runs as a PNG (skipped without matplotlib): each run's
-    ratio (one thread's time over two threads' right after it) for the unpinned and
-    pinned threads, ``match_many`` and the two GIL-free controls; when the later thread
-    began."""
+    ratio (one thread's time over two threads' right after it) for the unpinned threads
+    (marked where both were on one vCPU half-way through) and the pinned ones,
+    ``match_many`` and the two GIL-free controls; when the later thread began."""
     plt = pyplot()
     if plt is None:
         return
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.8))
     for key, marker, label in (
         ("unpinned", "o", "two threads started per run"),
+        ("unpinned_one_cpu", "k.", "… on one vCPU half-way through"),
         ("pinned", "s", "two pinned workers"),
         ("sha", "x", "control: SHA-256 (GIL released)"),
         ("bundles", "+", "control: 20-scan bundles"),
@@ -1363,10 +1365,18 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         bundles.append((merged, ref + convergence.starts(rng, 1, 0.05, 2.0)[0]))
 
     def work(
-        part: Sequence[tuple[F64, F64]], sink: list[F64], span: list[float] | None = None
+        part: Sequence[tuple[F64, F64]],
+        sink: list[F64],
+        span: list[float] | None = None,
+        mid: list[int | None] | None = None,
     ) -> None:
+        """Matches ``part`` into ``sink``; its start and end into ``span``, and the CPU
+        the thread is on half-way through into ``mid`` (one read of /proc, 10-30 µs)."""
+        half = len(part) // 2 if mid is not None else -1
         start = time.perf_counter()
-        for p, g in part:
+        for i, (p, g) in enumerate(part):
+            if i == half and mid is not None:
+                mid.append(pinned.current_cpu())
             sink.append(grid.match(p, g).pose)
         if span is not None:
             span += [start, time.perf_counter()]
@@ -1387,14 +1397,18 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
 
     def two(
         jobs: Sequence[tuple[F64, F64]] = jobs,
-    ) -> tuple[float, float, list[F64], float, float]:
+    ) -> tuple[float, float, list[F64], float, float, bool | None]:
         """Wall and CPU time, the poses in job order, the second thread's start after
-        the clock's (s) and the share of the wall time both threads were matching."""
+        the clock's (s), the share of the wall time both threads were matching, and
+        whether the two threads were on one CPU half-way through their halves (``None``
+        where the CPU cannot be read)."""
         sinks: list[list[F64]] = [[], []]
         spans: list[list[float]] = [[], []]
+        mids: list[list[int | None]] = [[], []]
         halves = [jobs[0::2], jobs[1::2]]
         ts = [
-            threading.Thread(target=work, args=(h, s, sp)) for h, s, sp in zip(halves, sinks, spans)
+            threading.Thread(target=work, args=(h, s, sp, m))
+            for h, s, sp, m in zip(halves, sinks, spans, mids)
         ]
         with no_gc():
             c0, t0 = time.process_time(), time.perf_counter()
@@ -1405,7 +1419,9 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             dt, cpu = time.perf_counter() - t0, time.process_time() - c0
         late = max(sp[0] for sp in spans)
         both = max(0.0, min(sp[1] for sp in spans) - late)
-        return dt, cpu, in_job_order(sinks), late - t0, both / dt
+        at = [m[0] if m else None for m in mids]
+        shared = None if None in at else at[0] == at[1]
+        return dt, cpu, in_job_order(sinks), late - t0, both / dt, shared
 
     # Control: the same one-vs-two-thread test on hashlib, which releases the GIL on large
     # buffers; it tells what parallelism the machine had free, whatever ndtgrid does.
@@ -1483,6 +1499,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     controls = []
     singles, doubles, cpu1, cpu2 = [], [], [], []
     lates, overlaps = [], []
+    shared: list[bool | None] = []
     bundle_1, bundle_2 = [], []
     pin_1, pin_2, pin_lates, pin_cpu1, pin_cpu2 = [], [], [], [], []
     many_1, many_2, many_cpu = [], [], []
@@ -1491,17 +1508,18 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         for rep in progress(range(args.thread_reps), "threads"):
             t1, c1, r1 = one()
             base = r1
-            t2, c2, r2, late, overlap = two()
+            t2, c2, r2, late, overlap, one_cpu = two()
             singles.append(t1)
             doubles.append(t2)
             cpu1.append(c1 / t1)
             cpu2.append(c2 / t2)
             lates.append(late)
             overlaps.append(overlap)
+            shared.append(one_cpu)
             same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
             controls.append(control())
             t1, _, r1 = one(bundles)
-            t2, _, r2, _, _ = two(bundles)
+            t2, _, r2, _, _, _ = two(bundles)
             bundle_1.append(t1)
             bundle_2.append(t2)
             same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
@@ -1538,6 +1556,26 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "bundles": list(np.divide(bundle_1, bundle_2)),
         "many": list(np.divide(many_1, many_2)),
     }
+    # The unpinned runs by where the kernel had the two threads half-way through.
+    known = [(r, sh) for r, sh in zip(per_run["unpinned"], shared) if sh is not None]
+    together = [r for r, sh in known if sh]
+    apart = [r for r, sh in known if not sh]
+    per_run["unpinned_one_cpu"] = [
+        r if sh else math.nan for r, sh in zip(per_run["unpinned"], shared)
+    ]
+
+    def median_or_dash(xs: list[float]) -> str:
+        return f"{float(np.median(xs)):.2f}×" if xs else "–"
+
+    cpu_text = (
+        "Half-way through its half of each two-thread run, each thread read the CPU it "
+        "was on (`current_cpu` in `benches/pinned.py`: one read of `/proc` per thread and "
+        "run, inside the timed run): the two were on one vCPU in "
+        f"{len(together)} of {len(known)} runs; median ratio {median_or_dash(together)} in "
+        f"those, {median_or_dash(apart)} in the others."
+        if known
+        else "Where the threads ran was not read (no `/proc/self/task`)."
+    )
     # match_many against the faster one-thread baseline too (its own, and the loop's).
     mm1, mm2 = n / np.median(many_1), n / np.median(many_2)
     mb1, mb2 = n / min(many_1), n / min(many_2)
@@ -1609,7 +1647,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             "new thread needs the GIL, and the busy first thread that hands it over may "
             "get it woken on its own vCPU: see the pinned rows); both threads were matching during "
             f"{', '.join(f'{100 * x:.0f}' for x in overlaps)} % of the run (the rest: one "
-            "thread started late or finished early).",
+            "thread started late or finished early). " + cpu_text,
             "",
             "Control, run after each pair of runs: SHA-256 of a 1 MiB buffer (`hashlib` "
             "releases the GIL), 128 hashes on one thread against 64 on each of two: "
@@ -1663,6 +1701,8 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "bundle_ratio": bundle_ratio,
         "many_ratio": many_ratio,
         "many_ratio_best": many_best,
+        "one_cpu_runs": len(together) if known else None,
+        "cpu_read_runs": len(known),
     }
 
 
@@ -1856,7 +1896,14 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
             "two threads ≥ 1.7× one (threads started for each run, placed by the kernel)",
             f"{t['ratio']:.2f}× (best runs {t['ratio_best']:.2f}×; GIL-free controls: "
             f"SHA-256 {t['control']:.2f}×, our matcher on {THREAD_BUNDLE}-scan bundles "
-            f"{t['bundle_ratio']:.2f}×)",
+            f"{t['bundle_ratio']:.2f}×"
+            + (
+                ""
+                if t.get("one_cpu_runs") is None
+                else f"; both threads on one vCPU half-way through in {t['one_cpu_runs']} "
+                f"of {t['cpu_read_runs']} runs"
+            )
+            + ")",
             t["ratio"] >= 1.7,
         )
         pr = t.get("pinned_ratio", math.nan)

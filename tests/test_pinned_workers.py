@@ -58,6 +58,33 @@ def test_each_worker_runs_on_its_own_cpu_only() -> None:
 
 
 @needs_two
+def test_current_cpu_is_the_cpu_a_pinned_worker_runs_on() -> None:
+    seen: list[tuple[int, int | None]] = []
+    lock = threading.Lock()
+
+    def task(i: int) -> None:
+        with lock:
+            seen.append((i, pinned.current_cpu()))
+
+    with pinned.PinnedWorkers(CPUS) as workers:
+        for _ in range(3):
+            workers.run([lambda: task(0), lambda: task(1)])
+    assert len(seen) == 6
+    for i, cpu in seen:
+        assert cpu == CPUS[i]
+
+
+def test_current_cpu_is_an_allowed_cpu_or_none_without_proc() -> None:
+    cpu = pinned.current_cpu()
+    if not os.path.exists(f"/proc/self/task/{threading.get_native_id()}/stat"):
+        assert cpu is None
+    elif hasattr(os, "sched_getaffinity"):
+        assert cpu in os.sched_getaffinity(0)
+    else:
+        assert isinstance(cpu, int) and cpu >= 0
+
+
+@needs_two
 def test_matches_on_pinned_workers_equal_the_main_threads() -> None:
     rng = np.random.default_rng(5)
     wall = np.c_[np.linspace(-1, 1, 200), np.full(200, 1.0)]
