@@ -8,6 +8,8 @@ the truth, the map is the one the scans make, and the numbers are consistent."""
 from __future__ import annotations
 
 import json
+import os
+import threading
 from collections.abc import Iterable, Iterator
 from typing import Any
 
@@ -19,6 +21,8 @@ from ndtgrid._progress import progress
 from ndtgrid.cli import main
 
 SCANS = 40
+#: Two CPUs the bench pins its threads to here, ``None`` where it cannot.
+PINNABLE = bench._pinnable_cpus(2)
 
 
 @pytest.fixture(scope="module")
@@ -49,6 +53,7 @@ def test_rows_are_the_timed_operations_with_consistent_numbers(
         "match_many, every core",
         "match, 1 Python thread",
         "match, 2 Python threads",
+        *([bench.PINNED_ROW] if PINNABLE is not None else []),
         "odometry step",
     ]
     calls = {r.name: r.calls for r in report.rows}
@@ -62,10 +67,16 @@ def test_rows_are_the_timed_operations_with_consistent_numbers(
         else:
             assert r.p90 is not None and r.p90 >= r.median, r.name
     rows = {r.name: r for r in report.rows}
-    for first, other, speedup in [
+    pairs: list[tuple[str, str, float | None]] = [
         ("match_many, one thread", "match_many, every core", report.match_many_speedup),
         ("match, 1 Python thread", "match, 2 Python threads", report.python_threads_speedup),
-    ]:
+    ]
+    if PINNABLE is not None:
+        pairs.append(("match, 1 Python thread", bench.PINNED_ROW, report.pinned_threads_speedup))
+    else:
+        assert report.pinned_threads_speedup is None
+    for first, other, speedup in pairs:
+        assert speedup is not None
         assert speedup == pytest.approx(rows[first].median / rows[other].median)
         rate = float(rows[first].note.removesuffix(" scans / s, median of 3 runs"))
         assert rate == pytest.approx(1e3 / rows[first].median, abs=0.5)
@@ -96,6 +107,7 @@ def test_report_as_json_and_table(report: bench.BenchReport) -> None:
     assert data["rows"][1]["name"] == "match"
     assert data["match_many_speedup"] == report.match_many_speedup
     assert data["python_threads_speedup"] == report.python_threads_speedup
+    assert data["pinned_threads_speedup"] == report.pinned_threads_speedup
     assert set(data["machine"]) == {"processor", "cores", "python", "ndtgrid", "platform"}
     table = report.table().splitlines()
     assert table[0].startswith(f"ndtgrid {report.machine['ndtgrid']} on ")
@@ -104,6 +116,72 @@ def test_report_as_json_and_table(report: bench.BenchReport) -> None:
     assert len(table) == 4 + len(report.rows)
     assert table[6].startswith("| match_many, one thread | ") and " | - | " in table[6]
     assert table[8].startswith("| match, 1 Python thread | ")
+
+
+def test_no_pinned_row_where_threads_cannot_be_pinned(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(bench, "_pinnable_cpus", lambda n: None)
+    report = bench.run_bench(bench.MIN_SCANS, repeats=1)
+    names = [r.name for r in report.rows]
+    assert "match, 2 Python threads" in names and bench.PINNED_ROW not in names
+    assert report.pinned_threads_speedup is None
+    assert json.loads(json.dumps(report.as_dict()))["pinned_threads_speedup"] is None
+
+
+def test_pinnable_cpus_are_allowed_ones() -> None:
+    if not hasattr(os, "sched_setaffinity"):
+        assert bench._pinnable_cpus(1) is None
+        return
+    allowed = sorted(os.sched_getaffinity(0))
+    assert bench._pinnable_cpus(1) == allowed[:1]
+    assert bench._pinnable_cpus(len(allowed)) == allowed
+    assert bench._pinnable_cpus(len(allowed) + 1) is None
+
+
+class _Recorder:
+    """Stands in for the grid: records each calling thread's CPUs and the scans it took."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.calls: list[tuple[int, frozenset[int], int]] = []
+
+    def match(self, points: Any, guess: Any) -> None:
+        with self.lock:
+            self.calls.append(
+                (threading.get_ident(), frozenset(os.sched_getaffinity(0)), int(points))
+            )
+
+
+@pytest.mark.skipif(PINNABLE is None, reason="needs os.sched_setaffinity and two CPUs")
+def test_pinned_threads_each_run_on_their_own_cpu_and_split_the_scans() -> None:
+    assert PINNABLE is not None
+    before = os.sched_getaffinity(0)
+    grid = _Recorder()
+    points = list(range(9))
+    ns = bench._threads_ns(grid, points, np.zeros((9, 3)), 2, PINNABLE)  # type: ignore[arg-type]
+    assert ns > 0
+    by_thread: dict[int, list[tuple[frozenset[int], int]]] = {}
+    for ident, cpus, scan in grid.calls:
+        by_thread.setdefault(ident, []).append((cpus, scan))
+    got = sorted(
+        (sorted(scan for _, scan in calls), {c for c, _ in calls}) for calls in by_thread.values()
+    )
+    assert got == [
+        ([0, 2, 4, 6, 8], {frozenset({PINNABLE[0]})}),
+        ([1, 3, 5, 7], {frozenset({PINNABLE[1]})}),
+    ]
+    assert os.sched_getaffinity(0) == before  # the caller is not pinned
+
+
+def test_a_thread_that_cannot_be_pinned_fails_the_run_and_leaves_no_thread() -> None:
+    if not hasattr(os, "sched_setaffinity"):
+        pytest.skip("needs os.sched_setaffinity")
+    bad = max(os.sched_getaffinity(0)) + 4096
+    threads = threading.active_count()
+    grid = _Recorder()
+    with pytest.raises(RuntimeError, match=rf"^could not pin a thread to CPU {bad}: "):
+        bench._threads_ns(grid, [0, 1], np.zeros((2, 3)), 1, [bad])  # type: ignore[arg-type]
+    assert grid.calls == []
+    assert threading.active_count() == threads
 
 
 def test_progress_wraps_the_simulation_with_its_total() -> None:

@@ -18,7 +18,9 @@ included; one call at a time on the calling thread unless said otherwise):
   thread and then on every core.
 - ``match, N Python threads``: the same matches by one, then two Python threads started
   together, each calling :meth:`~ndtgrid.NdtGrid.match` for every other scan (the GIL is
-  released during a match).
+  released during a match); on Linux with two CPUs to run on, also by two threads each
+  pinned to its own CPU (``os.sched_setaffinity``), as the README advises for matching
+  threads.
 - ``odometry``: :meth:`ndtgrid.Odometry.step` over the scans with drifting odometry, the
   whole SLAM front end (matching, its own grid's upkeep, and the §V map on a helper
   thread, waited for at the end).
@@ -63,6 +65,8 @@ RECOVERED = (0.01, math.radians(0.2))
 ODOMETRY_DRIFT = 0.02
 #: Inserts before the timed ones (the map first holds a few scans).
 UNTIMED_INSERTS = 10
+#: The row of two Python threads, each pinned to its own CPU.
+PINNED_ROW = "match, 2 Python threads, pinned"
 
 
 @dataclass(frozen=True)
@@ -162,19 +166,30 @@ class BenchReport:
         (median rounds)."""
         return self.speedup("match, 1 Python thread", "match, 2 Python threads")
 
+    @property
+    def pinned_threads_speedup(self) -> float | None:
+        """Scans per second of two Python threads calling ``match``, each pinned to its
+        own CPU, over one thread (median rounds); ``None`` where threads could not be
+        pinned (not Linux, or fewer than two CPUs to run on)."""
+        if not any(r.name == PINNED_ROW for r in self.rows):
+            return None
+        return self.speedup("match, 1 Python thread", PINNED_ROW)
+
     def as_dict(self) -> dict[str, Any]:
         """The report as plain values (for JSON).
 
         Returns
         -------
         dict
-            Every attribute (``rows`` as a list of dicts), and the two speed-ups
-            ``match_many_speedup`` and ``python_threads_speedup``.
+            Every attribute (``rows`` as a list of dicts), and the speed-ups
+            ``match_many_speedup``, ``python_threads_speedup`` and
+            ``pinned_threads_speedup`` (``None`` when not measured).
         """
         return {
             **asdict(self),
             "match_many_speedup": self.match_many_speedup,
             "python_threads_speedup": self.python_threads_speedup,
+            "pinned_threads_speedup": self.pinned_threads_speedup,
         }
 
     def table(self) -> str:
@@ -275,14 +290,44 @@ def _batch_rows(name: str, runs: dict[str, list[int]], scans: int) -> list[Bench
     return rows
 
 
-def _threads_ns(grid: NdtGrid, points: list[F64], guesses: F64, threads: int) -> int:
+def _pinnable_cpus(n: int) -> list[int] | None:
+    """The first ``n`` CPUs this process may run on, or ``None`` where threads cannot be
+    pinned (no ``os.sched_setaffinity``: not Linux) or fewer than ``n`` are allowed."""
+    if not hasattr(os, "sched_setaffinity"):
+        return None
+    cpus = sorted(os.sched_getaffinity(0))
+    return cpus[:n] if len(cpus) >= n else None
+
+
+def _threads_ns(
+    grid: NdtGrid,
+    points: list[F64],
+    guesses: F64,
+    threads: int,
+    cpus: list[int] | None = None,
+) -> int:
     """Nanoseconds ``threads`` Python threads, started together, take to match every scan
     (scan ``i`` on thread ``i mod threads``), one :meth:`~ndtgrid.NdtGrid.match` call
-    after the other; the clock runs from their start to the last one's end."""
+    after the other; the clock runs from their start to the last one's end. With
+    ``cpus``, thread ``k`` first pins itself to CPU ``cpus[k]``.
+
+    Raises
+    ------
+    RuntimeError
+        If a thread could not be pinned (no match is timed then).
+    """
     start = threading.Barrier(threads + 1)
+    failed: list[str] = []
 
     def work(k: int) -> None:
+        if cpus is not None:
+            try:
+                os.sched_setaffinity(0, {cpus[k]})
+            except OSError as e:
+                failed.append(f"could not pin a thread to CPU {cpus[k]}: {e}")
         start.wait()
+        if failed:
+            return
         for i in range(k, len(points), threads):
             grid.match(points[i], guesses[i])
 
@@ -293,6 +338,8 @@ def _threads_ns(grid: NdtGrid, points: list[F64], guesses: F64, threads: int) ->
     t0 = time.perf_counter_ns()
     for w in workers:
         w.join()
+    if failed:
+        raise RuntimeError(failed[0])
     return time.perf_counter_ns() - t0
 
 
@@ -399,15 +446,16 @@ def run_bench(
 
     many_runs = _batches({"one thread": many(1), "every core": many(None)}, repeats)
     rows += _batch_rows("match_many", many_runs, scans)
-    python_runs = _batches(
-        {
-            f"{n} Python thread{'s' if n > 1 else ''}": partial(
-                _threads_ns, grid, points, guesses, n
-            )
-            for n in (1, 2)
-        },
-        repeats,
-    )
+    python_timers: dict[str, Callable[[], int]] = {
+        f"{n} Python thread{'s' if n > 1 else ''}": partial(_threads_ns, grid, points, guesses, n)
+        for n in (1, 2)
+    }
+    cpus = _pinnable_cpus(2)
+    if cpus is not None:
+        python_timers[PINNED_ROW.removeprefix("match, ")] = partial(
+            _threads_ns, grid, points, guesses, 2, cpus
+        )
+    python_runs = _batches(python_timers, repeats)
     rows += _batch_rows("match", python_runs, scans)
 
     odometry = sim.odometry(truth, drift=ODOMETRY_DRIFT, seed=seed)
