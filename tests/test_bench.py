@@ -184,6 +184,20 @@ def test_a_thread_that_cannot_be_pinned_fails_the_run_and_leaves_no_thread() -> 
     assert threading.active_count() == threads
 
 
+def test_cli_bench_reports_a_thread_it_cannot_pin(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    if not hasattr(os, "sched_setaffinity"):
+        pytest.skip("needs os.sched_setaffinity")
+    bad = max(os.sched_getaffinity(0)) + 4096
+    monkeypatch.setattr(bench, "_pinnable_cpus", lambda n: [bad] * n)
+    assert main(["bench", "--scans", "20", "--quiet", "--repeats", "1"]) == 1
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.startswith(f"ndtgrid bench: could not pin a thread to CPU {bad}: ")
+    assert captured.err.count("\n") == 1
+
+
 def test_progress_wraps_the_simulation_with_its_total() -> None:
     seen: list[tuple[str, int, int]] = []
 

@@ -383,6 +383,9 @@ def run_bench(
     ------
     ValueError
         If ``scans`` or ``repeats`` is out of range.
+    RuntimeError
+        If a thread of the pinned row could not be pinned to its CPU (the CPUs this
+        process may run on changed during the run).
     """
     room = sim.sticks_room()
     tour = _tour(room)

@@ -289,6 +289,9 @@ def run_bench(args: argparse.Namespace) -> int:
     except ValueError as err:
         print(f"ndtgrid bench: {err}", file=sys.stderr)
         return 2
+    except RuntimeError as err:  # a thread could not be pinned to its CPU
+        print(f"ndtgrid bench: {err}", file=sys.stderr)
+        return 1
     print(json.dumps(report.as_dict()) if args.json else report.table())
     return 0
 
