@@ -1536,6 +1536,12 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
                 pin_2.append(t2)
                 pin_lates.append(late)
                 same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
+        # `match_many` in rounds of its own, after the others: run between the rounds
+        # above, its work on the calling thread lowered the next unpinned two-thread
+        # run's ratio by about 0.3 with the controls unchanged (8 alternated pairs;
+        # BENCHMARK.md, "Speed", session 32), so the Python threads are timed as they
+        # were before `match_many` joined the section.
+        for _ in progress(range(args.thread_reps), "match_many"):
             t1, c1, r1 = many(1)
             t2, c2, r2 = many(None)
             many_1.append(t1)
@@ -1673,8 +1679,9 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             f"`match_many`: the same {n} scans and guesses in one `NdtGrid.match_many` call "
             "(the GIL released once for the batch; the calling thread and a helper started for "
             "the batch each take the next scan not yet taken), on the calling thread alone and "
-            "then on every core, after "
-            "each pair of runs above; the ratio is taken against the faster of its own "
+            f"then on every core, in {args.thread_reps} rounds of its own after the runs above "
+            '(between them it lowered the unpinned ratio: BENCHMARK.md, "Speed", session '
+            "32); the ratio is taken against the faster of its own "
             "one-thread row and the first row. Per run (one thread's time over every core's "
             "right after it): "
             f"{', '.join(f'{r:.2f}' for r in per_run['many'])}; median "
