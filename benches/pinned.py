@@ -20,16 +20,16 @@ import threading
 from collections.abc import Callable, Sequence
 from types import TracebackType
 
+from ndtgrid.bench import pinnable_cpus
+
 Task = Callable[[], None]
 
 
 def two_cpus() -> list[int] | None:
     """The first two CPUs this process may run on, or ``None`` where threads cannot be
-    pinned (no ``os.sched_setaffinity``: not Linux) or fewer than two are allowed."""
-    if not hasattr(os, "sched_setaffinity"):
-        return None
-    cpus = sorted(os.sched_getaffinity(0))
-    return cpus[:2] if len(cpus) >= 2 else None
+    pinned (no ``os.sched_setaffinity``: not Linux) or fewer than two are allowed
+    (:func:`ndtgrid.bench.pinnable_cpus`, which ``ndtgrid bench`` pins its threads by)."""
+    return pinnable_cpus(2)
 
 
 def current_cpu() -> int | None:

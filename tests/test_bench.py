@@ -22,7 +22,7 @@ from ndtgrid.cli import main
 
 SCANS = 40
 #: Two CPUs the bench pins its threads to here, ``None`` where it cannot.
-PINNABLE = bench._pinnable_cpus(2)
+PINNABLE = bench.pinnable_cpus(2)
 
 
 @pytest.fixture(scope="module")
@@ -119,7 +119,7 @@ def test_report_as_json_and_table(report: bench.BenchReport) -> None:
 
 
 def test_no_pinned_row_where_threads_cannot_be_pinned(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(bench, "_pinnable_cpus", lambda n: None)
+    monkeypatch.setattr(bench, "pinnable_cpus", lambda n: None)
     report = bench.run_bench(bench.MIN_SCANS, repeats=1)
     names = [r.name for r in report.rows]
     assert "match, 2 Python threads" in names and bench.PINNED_ROW not in names
@@ -129,12 +129,12 @@ def test_no_pinned_row_where_threads_cannot_be_pinned(monkeypatch: pytest.Monkey
 
 def test_pinnable_cpus_are_allowed_ones() -> None:
     if not hasattr(os, "sched_setaffinity"):
-        assert bench._pinnable_cpus(1) is None
+        assert bench.pinnable_cpus(1) is None
         return
     allowed = sorted(os.sched_getaffinity(0))
-    assert bench._pinnable_cpus(1) == allowed[:1]
-    assert bench._pinnable_cpus(len(allowed)) == allowed
-    assert bench._pinnable_cpus(len(allowed) + 1) is None
+    assert bench.pinnable_cpus(1) == allowed[:1]
+    assert bench.pinnable_cpus(len(allowed)) == allowed
+    assert bench.pinnable_cpus(len(allowed) + 1) is None
 
 
 class _Recorder:
@@ -190,7 +190,7 @@ def test_cli_bench_reports_a_thread_it_cannot_pin(
     if not hasattr(os, "sched_setaffinity"):
         pytest.skip("needs os.sched_setaffinity")
     bad = max(os.sched_getaffinity(0)) + 4096
-    monkeypatch.setattr(bench, "_pinnable_cpus", lambda n: [bad] * n)
+    monkeypatch.setattr(bench, "pinnable_cpus", lambda n: [bad] * n)
     assert main(["bench", "--scans", "20", "--quiet", "--repeats", "1"]) == 1
     captured = capsys.readouterr()
     assert captured.out == ""

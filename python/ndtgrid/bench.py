@@ -49,7 +49,7 @@ from ndtgrid._core import NdtGrid, ranges_to_points
 from ndtgrid.evaluation import anchored_errors, pose_error
 from ndtgrid.odometry import Odometry
 
-__all__ = ["MIN_SCANS", "BenchReport", "BenchRow", "max_scans", "run_bench"]
+__all__ = ["MIN_SCANS", "BenchReport", "BenchRow", "max_scans", "pinnable_cpus", "run_bench"]
 
 F64 = npt.NDArray[np.float64]
 
@@ -290,9 +290,20 @@ def _batch_rows(name: str, runs: dict[str, list[int]], scans: int) -> list[Bench
     return rows
 
 
-def _pinnable_cpus(n: int) -> list[int] | None:
-    """The first ``n`` CPUs this process may run on, or ``None`` where threads cannot be
-    pinned (no ``os.sched_setaffinity``: not Linux) or fewer than ``n`` are allowed."""
+def pinnable_cpus(n: int) -> list[int] | None:
+    """The CPUs to pin ``n`` threads to, one each.
+
+    Parameters
+    ----------
+    n : int
+        Threads to pin.
+
+    Returns
+    -------
+    list of int or None
+        The first ``n`` CPUs this process may run on, or ``None`` where threads cannot be
+        pinned (no ``os.sched_setaffinity``: not Linux) or fewer than ``n`` are allowed.
+    """
     if not hasattr(os, "sched_setaffinity"):
         return None
     cpus = sorted(os.sched_getaffinity(0))
@@ -453,7 +464,7 @@ def run_bench(
         f"{n} Python thread{'s' if n > 1 else ''}": partial(_threads_ns, grid, points, guesses, n)
         for n in (1, 2)
     }
-    cpus = _pinnable_cpus(2)
+    cpus = pinnable_cpus(2)
     if cpus is not None:
         python_timers[PINNED_ROW.removeprefix("match, ")] = partial(
             _threads_ns, grid, points, guesses, 2, cpus
