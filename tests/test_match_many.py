@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import ast
 import math
+import os
+import subprocess
+import sys
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -221,3 +225,116 @@ def test_the_gil_is_free_while_it_runs() -> None:
     # (5 ms) after the call: under a twentieth of its pace over a call this long.
     assert spent > 0.1
     assert during > 0.2 * alone, (during, alone)
+
+
+def _thread_names() -> set[str]:
+    """The names (``comm``) of this process's threads now (Linux)."""
+    names = set()
+    for tid in os.listdir("/proc/self/task"):
+        try:
+            with open(f"/proc/self/task/{tid}/comm") as f:
+                names.add(f.read().strip())
+        except OSError:  # the thread ended meanwhile
+            pass
+    return names
+
+
+def _helpers_seen(call: Callable[[], object]) -> bool:
+    """Whether a ``ndtgrid-match`` helper thread existed while ``call`` ran (a Python
+    thread polls the thread list; the batch releases the GIL)."""
+    seen = [False]
+    stop = threading.Event()
+
+    def poll() -> None:
+        while not stop.is_set():
+            seen[0] |= "ndtgrid-match" in _thread_names()
+
+    t = threading.Thread(target=poll)
+    t.start()
+    try:
+        call()
+    finally:
+        stop.set()
+        t.join()
+    return seen[0]
+
+
+@pytest.mark.skipif(
+    not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2,
+    reason="needs Linux thread affinity and at least two CPUs to run on",
+)
+def test_threads_none_counts_the_cpus_of_the_calling_thread() -> None:
+    """``threads=None`` starts helpers only where the calling thread has CPUs for them:
+    from a thread pinned to one CPU (which a helper would inherit) the batch stays on
+    it, also after unpinned calls (the count is not kept from the first call)."""
+    grid = room_map()
+    scans, guesses = batch(8)
+    grid.match_many(scans[:1], guesses[:1])  # distributions built
+    t0 = time.perf_counter()
+    grid.match_many(scans, guesses, threads=1)
+    copies = max(1, math.ceil(0.2 / (time.perf_counter() - t0)))
+    scans, guesses = scans * copies, np.vstack([guesses] * copies)
+    want = [exact(r) for r in grid.match_many(scans, guesses, threads=1)]
+    # Unpinned: a helper, which the poller sees (so it would see one below).
+    assert _helpers_seen(lambda: grid.match_many(scans, guesses))
+    got: list[list[Any]] = []
+
+    def pinned() -> None:
+        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
+        got.append([exact(r) for r in grid.match_many(scans, guesses)])
+
+    def run_pinned() -> None:
+        t = threading.Thread(target=pinned)
+        t.start()
+        t.join()
+
+    assert not _helpers_seen(run_pinned)
+    assert got == [want]
+
+
+_PARALLEL_POOL_SCRIPT = """
+import os, threading, numpy as np, ndtgrid
+grid = ndtgrid.NdtGrid(0.02)
+rng = np.random.default_rng(0)
+t = rng.uniform(0, 2 * np.pi, 20000)
+points = np.column_stack([2 * np.cos(t), 2 * np.sin(t)]) + rng.normal(0, 0.003, (20000, 2))
+grid.insert(points, np.zeros(3))
+cpu = int(os.environ["NDT_TEST_CPU"]) if os.environ["NDT_TEST_CPU"] else None
+before = set(os.listdir("/proc/self/task"))
+def first_parallel_match():
+    if cpu is not None:
+        os.sched_setaffinity(0, {cpu})
+    grid.match(points, np.array([0.01, 0.0, 0.0]), parallel=True)
+th = threading.Thread(target=first_parallel_match)
+th.start()
+th.join()
+pool = set(os.listdir("/proc/self/task")) - before
+print(sorted(sorted(os.sched_getaffinity(int(tid))) for tid in pool))
+"""
+
+
+@pytest.mark.skipif(
+    not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2,
+    reason="needs Linux thread affinity and at least two CPUs to run on",
+)
+def test_the_parallel_option_pool_takes_the_first_callers_cpus() -> None:
+    """As the docs of ``parallel`` say: rayon's pool, started by the first parallel
+    match, has one thread per CPU of the thread that made it, on those CPUs (in a
+    child process: the pool is the process's)."""
+    allowed = sorted(os.sched_getaffinity(0))
+
+    def pool(cpu: int | None) -> list[list[int]]:
+        env = {k: v for k, v in os.environ.items() if k != "RAYON_NUM_THREADS"}
+        env["NDT_TEST_CPU"] = "" if cpu is None else str(cpu)
+        out = subprocess.run(
+            [sys.executable, "-c", _PARALLEL_POOL_SCRIPT],
+            env=env,
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout
+        pools: list[list[int]] = ast.literal_eval(out.strip())
+        return pools
+
+    assert pool(allowed[0]) == [[allowed[0]]]
+    assert pool(None) == [allowed] * len(allowed)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import threading
 
 import numpy as np
 import pytest
@@ -334,3 +335,45 @@ def test_intel_start_beats_raw_odometry() -> None:
     assert ours.n == 111
     assert ours.translation_mean < 0.75 * odom.translation_mean
     assert ours.rotation_mean < 0.3 * odom.rotation_mean
+
+
+@pytest.mark.skipif(
+    not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2,
+    reason="needs Linux thread affinity and at least two CPUs to run on",
+)
+def test_the_background_mapper_runs_where_the_thread_that_made_it_may() -> None:
+    """The helper starts with the ``Odometry`` and takes the CPU affinity of the thread
+    that makes it (as the docs of ``background_mapper`` say): made on a thread pinned to
+    one CPU, it is pinned there too; made on this thread, it may run where this one may."""
+
+    def tids() -> set[int]:
+        return {int(t) for t in os.listdir("/proc/self/task")}
+
+    def helper_cpus(make: bool, cpu: int | None) -> set[int]:
+        made: list[tuple[ndtgrid.Odometry, set[int]]] = []
+
+        def body() -> None:
+            if cpu is not None:
+                os.sched_setaffinity(0, {cpu})
+            before = tids()
+            odo = ndtgrid.Odometry(config=ndtgrid.OdometryConfig(background_mapper=make))
+            made.append((odo, tids() - before))
+
+        t = threading.Thread(target=body)
+        t.start()
+        t.join()
+        ((odo, new),) = made
+        if not make:
+            assert new == set()
+            return set()
+        (helper,) = new
+        cpus = os.sched_getaffinity(helper)
+        r, a = polar(np.zeros(3))
+        odo.step(r, a)  # the loop still runs on another thread than the one that made it
+        return cpus
+
+    allowed = os.sched_getaffinity(0)
+    first = min(allowed)
+    assert helper_cpus(True, first) == {first}
+    assert helper_cpus(True, None) == allowed
+    assert helper_cpus(False, first) == set()

@@ -331,7 +331,10 @@ class NdtGrid:
             and differs from the one-thread result in the last bits. Off by
             default: on 2 cores 16384 / 32000 points gained 1.26-1.42 / 1.44-1.50x (8192
             did not), and Python threads matching different scans use the cores
-            better (the GIL is released).
+            better (the GIL is released). Rayon's pool starts with the first such
+            match, one thread per CPU the calling thread may run on, on those
+            CPUs, and keeps them: make that match on a thread not pinned to one
+            CPU, or every later one runs on that CPU alone.
 
         Returns
         -------
@@ -378,11 +381,14 @@ class NdtGrid:
             Threads that match: the calling thread and ``threads - 1`` helpers,
             at most one thread per two scans (a helper costs about 0.1 ms before
             its first scan is done, so a batch of 2 or 3 scans stays on the
-            calling thread). ``None`` (default): one per core the process may
-            run on (``len(os.sched_getaffinity(0))`` on Linux, asked once per
-            process); 1: one scan after the other on the calling thread (with
-            the GIL released). A helper the system refuses to start leaves its
-            share to the others.
+            calling thread). ``None`` (default): one per CPU the calling
+            thread may run on (``len(os.sched_getaffinity(0))`` on Linux, read
+            at each call, and no more than the cgroup's CPU quota): a helper
+            inherits the CPUs of the thread that starts it, so from a thread
+            pinned to one CPU the batch stays on the calling thread; 1: one
+            scan after the other on the calling thread (with the GIL
+            released). A helper the system refuses to start leaves its share
+            to the others.
         **options
             Any keyword option of :meth:`match`, with the same default.
 

@@ -179,8 +179,13 @@ class OdometryConfig:
         waits for it. ``False``: on the loop's own thread, 8 inserted scans at a time
         (:attr:`Odometry.mapper` first takes in the rest). Poses and mapper are the
         same bit for bit either way; the default uses a second core (Intel log on 2
-        cores: BENCHMARK.md, "Speed"). Ignored with ``match_filtered_map`` (the mapper
-        then takes each scan at once).
+        cores: BENCHMARK.md, "Speed"). The helper starts with the :class:`Odometry`
+        and, on Linux, may run only on the CPUs the thread that makes it may run on
+        (a thread inherits them): make the :class:`Odometry` before pinning the
+        loop's thread to one CPU, or the helper shares that CPU (921 simulated
+        scans: 0.087-0.090 s against 0.054-0.069 s, BENCHMARK.md, "Speed", session
+        33). Ignored with ``match_filtered_map`` (the mapper then takes each scan at
+        once).
     build_map : bool, default True
         Build the map (:attr:`Odometry.mapper`) at all. ``False``: poses only, as a
         scan-to-map odometry such as KISS-ICP gives them. The loop keeps the grid it

@@ -19,6 +19,7 @@
 #![deny(missing_docs)]
 #![warn(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod affinity;
 pub mod batch;
 pub mod cell;
 pub mod cellmask;

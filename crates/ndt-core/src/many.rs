@@ -18,7 +18,6 @@
 
 use std::any::Any;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::OnceLock;
 use std::thread;
 
 use crate::error::{NdtError, Result};
@@ -34,10 +33,12 @@ impl NdtGrid {
     ///
     /// `threads`: how many threads match: the calling thread and `threads −
     /// 1` helpers, at most one thread per two scans.
-    /// `None`: one per core the process may run on
-    /// ([`std::thread::available_parallelism`], asked once per process);
-    /// `Some(1)`: the calling thread alone. A helper the system refuses to
-    /// start leaves its share to the others.
+    /// `None`: one per CPU the calling thread may run on (as
+    /// [`std::thread::available_parallelism`] counts them for it: its CPU
+    /// affinity and the cgroup's quota; see [`crate::affinity`]), since the
+    /// helpers inherit the caller's affinity; `Some(1)`: the calling thread
+    /// alone. A helper the system refuses to start leaves its share to the
+    /// others.
     ///
     /// Everything is checked before any scan is matched: the options, the
     /// number of guesses, and each scan as [`NdtGrid::match_scan`] checks
@@ -83,7 +84,7 @@ impl NdtGrid {
             Some(phases) => self.phased_checked(scans[i], guesses[i], options, phases, levels),
             None => self.match_checked(scans[i], guesses[i], options, levels),
         };
-        let threads = threads.unwrap_or_else(cores);
+        let threads = threads.unwrap_or_else(crate::affinity::threads_for_caller);
         let results = spread(scans.len(), threads, one)?;
         // Nothing fails once the inputs are checked; should a scan still
         // fail, the first one's error is the call's.
@@ -101,16 +102,9 @@ impl NdtGrid {
 /// scans (about 0.1 ms each) on 2 cores ran at 0.74, 0.86 and 1.22× the
 /// one-thread rate with a helper for any batch (and the cores asked on
 /// every call), at 1.00, 0.99–1.01 and 1.45–1.51× with this bound and
-/// [`cores`] (BENCHMARK.md, "Speed", session 30).
+/// the count of cores asked once (BENCHMARK.md, "Speed", session 30; the
+/// count now comes from [`crate::affinity::threads_for_caller`]).
 const MIN_SCANS_PER_THREAD: usize = 2;
-
-/// The cores the process may run on, asked once
-/// ([`std::thread::available_parallelism`] reads the cgroup's files: tens
-/// of microseconds a call).
-fn cores() -> usize {
-    static CORES: OnceLock<usize> = OnceLock::new();
-    *CORES.get_or_init(|| thread::available_parallelism().map_or(1, usize::from))
-}
 
 /// `f(0) … f(n − 1)` in order, computed by the calling thread and up to
 /// `threads − 1` helper threads started here (at most one thread per

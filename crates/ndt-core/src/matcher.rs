@@ -198,7 +198,10 @@ pub struct MatchOptions {
     /// / 1.44–1.50× faster (two runs, session 5); 8192 points did not gain (hence the threshold), and with
     /// 256-point chunks 2000 points were 2.3× slower (each of a match's ~40
     /// evaluations wakes the pool). Python threads matching different scans
-    /// use the cores better (the GIL is released while matching).
+    /// use the cores better (the GIL is released while matching). The pool
+    /// starts with the first such match and keeps the CPU affinity of the
+    /// thread that made it (one thread per CPU that thread may run on): made
+    /// from a thread pinned to one CPU, it has one thread, on that CPU.
     pub parallel: bool,
 }
 

@@ -236,7 +236,10 @@ pub struct OdometryConfig {
     /// mapper first takes in the rest). The poses and the mapper are the
     /// same bit for bit either way. On by default: it takes one more core
     /// (the helper sleeps when idle) and the Intel log runs in less time on
-    /// 2 cores (BENCHMARK.md, "Speed"). Ignored with
+    /// 2 cores (BENCHMARK.md, "Speed"). The helper starts with the
+    /// [`Odometry`] and inherits the CPU affinity of the thread that makes
+    /// it (Linux): made on a thread pinned to one CPU, it shares that CPU
+    /// with the loop (BENCHMARK.md, "Speed", session 33). Ignored with
     /// [`OdometryConfig::match_filtered_map`] (the loop then matches against
     /// the mapper's grid, so it takes each scan at once).
     pub background_mapper: bool,
