@@ -190,16 +190,21 @@ def test_bad_input_is_refused_with_the_scan_named(
     assert str(info.value) == message
 
 
+def long_batch(grid: ndtgrid.NdtGrid, seconds: float) -> tuple[list[np.ndarray], np.ndarray]:
+    """Copies of ``batch(8)`` enough for a one-thread call of about ``seconds`` on this
+    machine (timed once, with the distributions built first)."""
+    scans, guesses = batch(8)
+    grid.match_many(scans[:1], guesses[:1])  # distributions built
+    t0 = time.perf_counter()
+    grid.match_many(scans, guesses, threads=1)
+    copies = max(1, math.ceil(seconds / (time.perf_counter() - t0)))
+    return scans * copies, np.vstack([guesses] * copies)
+
+
 def test_the_gil_is_free_while_it_runs() -> None:
     """A Python thread keeps counting while the batch runs on the calling thread."""
     grid = room_map()
-    scans, guesses = batch(8)
-    grid.match_many(scans[:1], guesses[:1])  # distributions built
-    # Enough copies for a call of about 0.3 s on this machine.
-    t0 = time.perf_counter()
-    grid.match_many(scans, guesses, threads=1)
-    copies = max(1, math.ceil(0.3 / (time.perf_counter() - t0)))
-    scans, guesses = scans * copies, np.vstack([guesses] * copies)
+    scans, guesses = long_batch(grid, 0.3)
     count = [0]
     stop = threading.Event()
 
@@ -268,12 +273,7 @@ def test_threads_none_counts_the_cpus_of_the_calling_thread() -> None:
     from a thread pinned to one CPU (which a helper would inherit) the batch stays on
     it, also after unpinned calls (the count is not kept from the first call)."""
     grid = room_map()
-    scans, guesses = batch(8)
-    grid.match_many(scans[:1], guesses[:1])  # distributions built
-    t0 = time.perf_counter()
-    grid.match_many(scans, guesses, threads=1)
-    copies = max(1, math.ceil(0.2 / (time.perf_counter() - t0)))
-    scans, guesses = scans * copies, np.vstack([guesses] * copies)
+    scans, guesses = long_batch(grid, 0.2)
     want = [exact(r) for r in grid.match_many(scans, guesses, threads=1)]
     # Unpinned: a helper, which the poller sees (so it would see one below).
     assert _helpers_seen(lambda: grid.match_many(scans, guesses))
