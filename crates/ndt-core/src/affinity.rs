@@ -6,7 +6,7 @@
 //! starts it, so a batch's helpers run on the CPUs its caller may run on.
 //! [`std::thread::available_parallelism`] answers for the calling thread
 //! (its affinity, and the cgroup's CPU quota), but it reads the cgroup's
-//! files: about 26 µs a call on this project's VM, a quarter of a 683-point
+//! files: about 26 µs a call on this project's VM, 40 % of a 683-point
 //! match. The count used to be asked once per process, so a batch called
 //! from a thread pinned to one CPU (as `README.md` tells users to pin their
 //! matching threads) after one from an unpinned thread started a helper on
