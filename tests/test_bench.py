@@ -20,9 +20,9 @@ from ndtgrid import NdtGrid, bench, ranges_to_points, sim
 from ndtgrid._progress import progress
 from ndtgrid.cli import main
 
+from ._cpus import TWO_CPUS, needs_two_cpus
+
 SCANS = 40
-#: Two CPUs the bench pins its threads to here, ``None`` where it cannot.
-PINNABLE = bench.pinnable_cpus(2)
 
 
 @pytest.fixture(scope="module")
@@ -53,7 +53,7 @@ def test_rows_are_the_timed_operations_with_consistent_numbers(
         "match_many, every core",
         "match, 1 Python thread",
         "match, 2 Python threads",
-        *([bench.PINNED_ROW] if PINNABLE is not None else []),
+        *([bench.PINNED_ROW] if TWO_CPUS is not None else []),
         "odometry step",
     ]
     calls = {r.name: r.calls for r in report.rows}
@@ -71,7 +71,7 @@ def test_rows_are_the_timed_operations_with_consistent_numbers(
         ("match_many, one thread", "match_many, every core", report.match_many_speedup),
         ("match, 1 Python thread", "match, 2 Python threads", report.python_threads_speedup),
     ]
-    if PINNABLE is not None:
+    if TWO_CPUS is not None:
         pairs.append(("match, 1 Python thread", bench.PINNED_ROW, report.pinned_threads_speedup))
     else:
         assert report.pinned_threads_speedup is None
@@ -151,13 +151,13 @@ class _Recorder:
             )
 
 
-@pytest.mark.skipif(PINNABLE is None, reason="needs os.sched_setaffinity and two CPUs")
+@needs_two_cpus
 def test_pinned_threads_each_run_on_their_own_cpu_and_split_the_scans() -> None:
-    assert PINNABLE is not None
+    assert TWO_CPUS is not None
     before = os.sched_getaffinity(0)
     grid = _Recorder()
     points = list(range(9))
-    ns = bench._threads_ns(grid, points, np.zeros((9, 3)), 2, PINNABLE)  # type: ignore[arg-type]
+    ns = bench._threads_ns(grid, points, np.zeros((9, 3)), 2, TWO_CPUS)  # type: ignore[arg-type]
     assert ns > 0
     by_thread: dict[int, list[tuple[frozenset[int], int]]] = {}
     for ident, cpus, scan in grid.calls:
@@ -166,8 +166,8 @@ def test_pinned_threads_each_run_on_their_own_cpu_and_split_the_scans() -> None:
         (sorted(scan for _, scan in calls), {c for c, _ in calls}) for calls in by_thread.values()
     )
     assert got == [
-        ([0, 2, 4, 6, 8], {frozenset({PINNABLE[0]})}),
-        ([1, 3, 5, 7], {frozenset({PINNABLE[1]})}),
+        ([0, 2, 4, 6, 8], {frozenset({TWO_CPUS[0]})}),
+        ([1, 3, 5, 7], {frozenset({TWO_CPUS[1]})}),
     ]
     assert os.sched_getaffinity(0) == before  # the caller is not pinned
 

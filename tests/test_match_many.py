@@ -18,6 +18,7 @@ import pytest
 
 import ndtgrid
 
+from ._cpus import TWO_CPUS, needs_two_cpus
 from ._results import exact
 from ._room import scan
 
@@ -264,10 +265,7 @@ def _helpers_seen(call: Callable[[], object]) -> bool:
     return seen[0]
 
 
-@pytest.mark.skipif(
-    not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2,
-    reason="needs Linux thread affinity and at least two CPUs to run on",
-)
+@needs_two_cpus
 def test_threads_none_counts_the_cpus_of_the_calling_thread() -> None:
     """``threads=None`` starts helpers only where the calling thread has CPUs for them:
     from a thread pinned to one CPU (which a helper would inherit) the batch stays on
@@ -280,7 +278,8 @@ def test_threads_none_counts_the_cpus_of_the_calling_thread() -> None:
     got: list[list[Any]] = []
 
     def pinned() -> None:
-        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
+        assert TWO_CPUS is not None
+        os.sched_setaffinity(0, {TWO_CPUS[0]})
         got.append([exact(r) for r in grid.match_many(scans, guesses)])
 
     def run_pinned() -> None:
@@ -313,14 +312,12 @@ print(sorted(sorted(os.sched_getaffinity(int(tid))) for tid in pool))
 """
 
 
-@pytest.mark.skipif(
-    not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2,
-    reason="needs Linux thread affinity and at least two CPUs to run on",
-)
+@needs_two_cpus
 def test_the_parallel_option_pool_takes_the_first_callers_cpus() -> None:
     """As the docs of ``parallel`` say: rayon's pool, started by the first parallel
     match, has one thread per CPU of the thread that made it, on those CPUs (in a
     child process: the pool is the process's)."""
+    assert TWO_CPUS is not None
     allowed = sorted(os.sched_getaffinity(0))
 
     def pool(cpu: int | None) -> list[list[int]]:
@@ -336,5 +333,5 @@ def test_the_parallel_option_pool_takes_the_first_callers_cpus() -> None:
         pools: list[list[int]] = ast.literal_eval(out.strip())
         return pools
 
-    assert pool(allowed[0]) == [[allowed[0]]]
+    assert pool(TWO_CPUS[0]) == [[TWO_CPUS[0]]]
     assert pool(None) == [allowed] * len(allowed)

@@ -16,6 +16,7 @@ from ndtgrid._core import default_odometry_config
 from ndtgrid.evaluation import relation_errors
 from ndtgrid.io import read_benchmark_index, read_benchmark_split
 
+from ._cpus import TWO_CPUS, needs_two_cpus
 from ._room import scan as room_scan
 
 BEAMS = 361
@@ -337,10 +338,7 @@ def test_intel_start_beats_raw_odometry() -> None:
     assert ours.rotation_mean < 0.3 * odom.rotation_mean
 
 
-@pytest.mark.skipif(
-    not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2,
-    reason="needs Linux thread affinity and at least two CPUs to run on",
-)
+@needs_two_cpus
 def test_the_background_mapper_runs_where_the_thread_that_made_it_may() -> None:
     """The helper starts with the ``Odometry`` and takes the CPU affinity of the thread
     that makes it (as the docs of ``background_mapper`` say): made on a thread pinned to
@@ -372,8 +370,9 @@ def test_the_background_mapper_runs_where_the_thread_that_made_it_may() -> None:
         odo.step(r, a)  # the loop still runs on another thread than the one that made it
         return cpus
 
+    assert TWO_CPUS is not None
     allowed = os.sched_getaffinity(0)
-    first = min(allowed)
+    first = TWO_CPUS[0]
     assert helper_cpus(True, first) == {first}
     assert helper_cpus(True, None) == allowed
     assert helper_cpus(False, first) == set()
