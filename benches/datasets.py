@@ -38,6 +38,7 @@ import numpy.typing as npt
 
 import ndtgrid
 from ndtgrid import se2
+from ndtgrid.bench import processor_name
 from ndtgrid.evaluation import RelationSummary, relation_errors
 from ndtgrid.io import Scan, read_benchmark_index, read_benchmark_split
 
@@ -239,19 +240,15 @@ def fmt_rot(s: RelationSummary) -> str:
 
 
 def machine() -> str:
-    cpu = platform.processor() or "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            cpu = next(ln.split(":", 1)[1].strip() for ln in f if ln.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
+    """Cores, processor (:func:`ndtgrid.bench.processor_name`), Python and commit."""
+    cpu = processor_name()
     try:
         commit = subprocess.run(
             ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True
         ).stdout.strip()
     except (OSError, subprocess.CalledProcessError):
         commit = "unknown"
-    return f"{os.cpu_count()} cores ({cpu}), Python {platform.python_version()}, commit {commit}"
+    return f"{os.cpu_count()} cores of {cpu}, Python {platform.python_version()}, commit {commit}"
 
 
 def main() -> int:

@@ -42,7 +42,9 @@ as a Markdown table to stdout as soon as it is measured (progress goes to stderr
 A table of the issue's targets against this run's numbers closes the output.
 
 Run from the repository root (needs ``pip install -e ".[bench]"`` and
-``../shared/data/real``; about 4 min on 2 shared cores, ``--quick`` under 1 min)::
+``../shared/data/real``; Open3D's wheel also needs the system's ``libusb-1.0``, on
+Debian ``apt-get install libusb-1.0-0``, or its peers are skipped with the loader's
+error; about 4 min on 2 shared cores, ``--quick`` under 1 min)::
 
     python benches/speed.py > out/speed.md
     python benches/speed.py --quick --sections match threads

@@ -30,15 +30,13 @@ for the pictures (``--no-plots`` skips them).
 from __future__ import annotations
 
 import argparse
-import os
-import platform
-import subprocess
 import time
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from datasets import machine
 from subgrid_common import (
     COUNT_KEYS,
     F64,
@@ -257,29 +255,6 @@ def report_sim(results: list[Result], seeds: range) -> str:
 
 
 scenario_len_cache: list[int] = []
-
-
-def machine() -> str:
-    """nproc, CPU model and commit, for BENCHMARK.md."""
-    cpu = "unknown CPU"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    try:
-        commit = subprocess.run(
-            ["git", "rev-parse", "--short", "HEAD"],
-            capture_output=True,
-            text=True,
-            check=False,
-            cwd=Path(__file__).parent,
-        ).stdout.strip()
-    except OSError:
-        commit = "unknown"
-    return f"{os.cpu_count()} cores ({cpu}), Python {platform.python_version()}, commit {commit}"
 
 
 def main() -> None:

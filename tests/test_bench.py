@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import json
 import os
+import platform
 import threading
 from collections.abc import Iterable, Iterator
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -101,6 +103,40 @@ def test_the_map_is_the_one_the_scans_make(report: bench.BenchReport) -> None:
     assert report.points == int(np.median([len(p) for p in points]))
 
 
+# Two processors of a VM as /proc/cpuinfo gives them (trimmed): the first one is read.
+EPYC_CPUINFO = """processor\t: 0
+vendor_id\t: AuthenticAMD
+cpu family\t: 25
+model\t\t: 17
+model name\t: AMD EPYC
+stepping\t: 1
+flags\t\t: fpu sse2 avx avx2 fma avx512f avx512dq
+
+processor\t: 1
+vendor_id\t: AuthenticAMD
+cpu family\t: 26
+model\t\t: 2
+model name\t: AMD EPYC 9005
+stepping\t: 0
+flags\t\t: fpu sse2
+"""
+
+
+def test_the_processor_is_named_with_its_family_model_and_vector_extension() -> None:
+    assert bench.processor_name(EPYC_CPUINFO) == (
+        "AMD EPYC (family 25, model 17, stepping 1; AVX-512)"
+    )
+    xeon = "model name\t: Intel(R) Xeon(R) Processor\nflags\t: fpu avx avx2\n"
+    assert bench.processor_name(xeon) == "Intel(R) Xeon(R) Processor (AVX2)"
+    assert bench.processor_name("model name\t: ARM\nflags\t: fp asimd\n") == "ARM"
+    # Without the file's text the name falls back to the platform's.
+    assert bench.processor_name("") == (platform.processor() or platform.machine())
+    # Read from the file, where there is one, the name is that file's.
+    cpuinfo = Path("/proc/cpuinfo")
+    if cpuinfo.exists():
+        assert bench.processor_name() == bench.processor_name(cpuinfo.read_text())
+
+
 def test_report_as_json_and_table(report: bench.BenchReport) -> None:
     data = json.loads(json.dumps(report.as_dict()))
     assert data["scans"] == SCANS and len(data["rows"]) == len(report.rows)
@@ -109,6 +145,7 @@ def test_report_as_json_and_table(report: bench.BenchReport) -> None:
     assert data["python_threads_speedup"] == report.python_threads_speedup
     assert data["pinned_threads_speedup"] == report.pinned_threads_speedup
     assert set(data["machine"]) == {"processor", "cores", "python", "ndtgrid", "platform"}
+    assert data["machine"]["processor"] == bench.processor_name()
     table = report.table().splitlines()
     assert table[0].startswith(f"ndtgrid {report.machine['ndtgrid']} on ")
     assert f"{SCANS} simulated URG-04LX scans" in table[0]

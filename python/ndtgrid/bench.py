@@ -49,7 +49,15 @@ from ndtgrid._core import NdtGrid, ranges_to_points
 from ndtgrid.evaluation import anchored_errors, pose_error
 from ndtgrid.odometry import Odometry
 
-__all__ = ["MIN_SCANS", "BenchReport", "BenchRow", "max_scans", "pinnable_cpus", "run_bench"]
+__all__ = [
+    "MIN_SCANS",
+    "BenchReport",
+    "BenchRow",
+    "max_scans",
+    "pinnable_cpus",
+    "processor_name",
+    "run_bench",
+]
 
 F64 = npt.NDArray[np.float64]
 
@@ -232,20 +240,58 @@ def _tour(room: sim.World) -> F64:
     return sim.trajectory(room.tour)
 
 
+def processor_name(cpuinfo: str | None = None) -> str:
+    """The processor, named so that two machines under one model name can be told apart.
+
+    A virtual machine's ``model name`` can be as vague as ``AMD EPYC`` for several
+    generations of processor, whose speed on the same code differs by half
+    (``BENCHMARK.md``, "Speed", session 34), so the family, model and stepping follow
+    it, and the widest vector extension the core's kernels can pick at run time.
+
+    Parameters
+    ----------
+    cpuinfo : str, optional
+        The text of ``/proc/cpuinfo`` (its first processor is read); read from the
+        file when not given.
+
+    Returns
+    -------
+    str
+        For example ``"AMD EPYC (family 25, model 17, stepping 1; AVX-512)"``; the
+        fields the text lacks are left out, and without the text (not Linux) it is
+        :func:`platform.processor` or :func:`platform.machine`.
+    """
+    if cpuinfo is None:
+        try:
+            with open("/proc/cpuinfo", encoding="utf-8") as f:
+                cpuinfo = f.read()
+        except OSError:
+            cpuinfo = ""
+    fields: dict[str, str] = {}
+    for line in cpuinfo.splitlines():
+        if not line.strip():
+            if fields:
+                break  # the first processor's block only
+            continue
+        key, _, value = line.partition(":")
+        fields.setdefault(key.strip(), value.strip())
+    name = fields.get("model name") or platform.processor() or platform.machine()
+    ids = [
+        f"{label} {fields[key]}"
+        for label, key in (("family", "cpu family"), ("model", "model"), ("stepping", "stepping"))
+        if fields.get(key)
+    ]
+    flags = set(fields.get("flags", "").split())
+    simd = next((n for f, n in (("avx512f", "AVX-512"), ("avx2", "AVX2")) if f in flags), None)
+    detail = "; ".join(x for x in (", ".join(ids), simd) if x)
+    return f"{name} ({detail})" if detail else name
+
+
 def _machine() -> dict[str, str]:
     """Processor, cores, Python and ndtgrid versions of this machine."""
-    name = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    name = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     return {
-        "processor": name,
+        "processor": processor_name(),
         "cores": str(cores),
         "python": platform.python_version(),
         "ndtgrid": __version__,
