@@ -147,7 +147,10 @@ def test_report_as_json_and_table(report: bench.BenchReport) -> None:
     assert set(data["machine"]) == {"processor", "cores", "python", "ndtgrid", "platform"}
     assert data["machine"]["processor"] == bench.processor_name()
     table = report.table().splitlines()
-    assert table[0].startswith(f"ndtgrid {report.machine['ndtgrid']} on ")
+    m = report.machine
+    assert table[0].startswith(
+        f"ndtgrid {m['ndtgrid']} on {m['cores']} cores of {m['processor']}, Python "
+    )
     assert f"{SCANS} simulated URG-04LX scans" in table[0]
     assert table[2] == "| operation | median | p90 | calls | checked |"
     assert len(table) == 4 + len(report.rows)

@@ -210,8 +210,8 @@ class BenchReport:
         """
         m = self.machine
         lines = [
-            f"ndtgrid {m.get('ndtgrid', '?')} on {m.get('processor', '?')} "
-            f"({m.get('cores', '?')} cores), Python {m.get('python', '?')}: "
+            f"ndtgrid {m.get('ndtgrid', '?')} on {m.get('cores', '?')} cores of "
+            f"{m.get('processor', '?')}, Python {m.get('python', '?')}: "
             f"{self.scans} simulated URG-04LX scans of {self.points} points, "
             f"2 cm cells ({self.map_cells} cells, {self.map_bytes_per_cell:.0f} B / cell).",
             "",
