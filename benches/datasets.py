@@ -38,7 +38,7 @@ import numpy.typing as npt
 
 import ndtgrid
 from ndtgrid import se2
-from ndtgrid.bench import processor_name
+from ndtgrid.bench import kernels_name, processor_name
 from ndtgrid.evaluation import RelationSummary, relation_errors
 from ndtgrid.io import Scan, read_benchmark_index, read_benchmark_split
 
@@ -240,8 +240,9 @@ def fmt_rot(s: RelationSummary) -> str:
 
 
 def machine() -> str:
-    """Cores, processor (:func:`ndtgrid.bench.processor_name`), Python and commit."""
-    cpu = processor_name()
+    """Cores, processor and kernels (:func:`ndtgrid.bench.processor_name`,
+    :func:`ndtgrid.bench.kernels_name`), Python and commit."""
+    cpu = f"{processor_name()}, {kernels_name()}"
     try:
         commit = subprocess.run(
             ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from ndtgrid import NdtGrid, bench, ranges_to_points, sim
+from ndtgrid._core import vector_extension
 from ndtgrid._progress import progress
 from ndtgrid.cli import main
 
@@ -110,7 +111,7 @@ cpu family\t: 25
 model\t\t: 17
 model name\t: AMD EPYC
 stepping\t: 1
-flags\t\t: fpu sse2 avx avx2 fma avx512f avx512dq
+flags\t\t: fpu sse2 avx avx2 fma avx512f avx512dq avx512vl
 
 processor\t: 1
 vendor_id\t: AuthenticAMD
@@ -122,19 +123,44 @@ flags\t\t: fpu sse2
 """
 
 
-def test_the_processor_is_named_with_its_family_model_and_vector_extension() -> None:
-    assert bench.processor_name(EPYC_CPUINFO) == (
-        "AMD EPYC (family 25, model 17, stepping 1; AVX-512)"
+def test_the_processor_is_named_with_its_identifiers() -> None:
+    assert bench.processor_name(EPYC_CPUINFO) == "AMD EPYC (family 25, model 17, stepping 1)"
+    xeon = "model name\t: Intel(R) Xeon(R) Processor\nflags\t: fpu avx avx2 fma\n"
+    assert bench.processor_name(xeon) == "Intel(R) Xeon(R) Processor"
+    # A Raspberry Pi 5's Cortex-A76 (trimmed): no model name, ARM's identifiers.
+    pi5 = (
+        "processor\t: 0\nBogoMIPS\t: 108.00\nFeatures\t: fp asimd evtstrm aes crc32\n"
+        "CPU implementer\t: 0x41\nCPU architecture: 8\nCPU variant\t: 0x4\n"
+        "CPU part\t: 0xd0b\nCPU revision\t: 1\n"
     )
-    xeon = "model name\t: Intel(R) Xeon(R) Processor\nflags\t: fpu avx avx2\n"
-    assert bench.processor_name(xeon) == "Intel(R) Xeon(R) Processor (AVX2)"
-    assert bench.processor_name("model name\t: ARM\nflags\t: fp asimd\n") == "ARM"
+    fallback = platform.processor() or platform.machine()
+    assert bench.processor_name(pi5) == (
+        f"{fallback} (implementer 0x41, part 0xd0b, variant 0x4, revision 1)"
+    )
     # Without the file's text the name falls back to the platform's.
-    assert bench.processor_name("") == (platform.processor() or platform.machine())
+    assert bench.processor_name("") == fallback
     # Read from the file, where there is one, the name is that file's.
     cpuinfo = Path("/proc/cpuinfo")
     if cpuinfo.exists():
         assert bench.processor_name() == bench.processor_name(cpuinfo.read_text())
+
+
+def test_the_kernels_named_are_those_the_core_runs_and_the_flags_allow() -> None:
+    name = bench.kernels_name()
+    assert name in {"AVX-512 kernels", "AVX2 kernels", "NEON kernels", "generic kernels"}
+    assert name == f"{vector_extension() or 'generic'} kernels"
+    # On Linux the processor's flags say which build it can run (the kernels'
+    # targets: AVX-512 needs F, DQ and VL with AVX2 and FMA; AVX2 needs FMA).
+    cpuinfo = Path("/proc/cpuinfo")
+    if cpuinfo.exists() and platform.machine() == "x86_64":
+        text = cpuinfo.read_text()
+        flags = set(next(ln for ln in text.splitlines() if ln.startswith("flags")).split())
+        if {"avx512f", "avx512dq", "avx512vl", "avx2", "fma"} <= flags:
+            assert name == "AVX-512 kernels"
+        elif {"avx2", "fma"} <= flags:
+            assert name == "AVX2 kernels"
+        else:
+            assert name == "generic kernels"
 
 
 def test_report_as_json_and_table(report: bench.BenchReport) -> None:
@@ -144,12 +170,20 @@ def test_report_as_json_and_table(report: bench.BenchReport) -> None:
     assert data["match_many_speedup"] == report.match_many_speedup
     assert data["python_threads_speedup"] == report.python_threads_speedup
     assert data["pinned_threads_speedup"] == report.pinned_threads_speedup
-    assert set(data["machine"]) == {"processor", "cores", "python", "ndtgrid", "platform"}
+    assert set(data["machine"]) == {
+        "processor",
+        "kernels",
+        "cores",
+        "python",
+        "ndtgrid",
+        "platform",
+    }
     assert data["machine"]["processor"] == bench.processor_name()
+    assert data["machine"]["kernels"] == bench.kernels_name()
     table = report.table().splitlines()
     m = report.machine
     assert table[0].startswith(
-        f"ndtgrid {m['ndtgrid']} on {m['cores']} cores of {m['processor']}, Python "
+        f"ndtgrid {m['ndtgrid']} on {m['cores']} cores of {m['processor']}, {m['kernels']}, Python "
     )
     assert f"{SCANS} simulated URG-04LX scans" in table[0]
     assert table[2] == "| operation | median | p90 | calls | checked |"

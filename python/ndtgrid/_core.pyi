@@ -986,6 +986,19 @@ def inverse(p: ArrayLike) -> F64Array:
 def between(a: ArrayLike, b: ArrayLike) -> F64Array:
     """``a^-1 o b``: the motion from ``a`` to ``b`` in ``a``'s frame, shape (3,)."""
 
+def vector_extension() -> str | None:
+    """The vector extension of the core's kernels on this processor.
+
+    The score terms, the scan's cell keys and the moments each have an AVX-512, an
+    AVX2 and a NEON build besides a generic one, and the widest the processor supports
+    runs (picked at run time).
+
+    Returns
+    -------
+    str or None
+        ``"AVX-512"``, ``"AVX2"`` or ``"NEON"``; ``None`` for the generic build.
+    """
+
 def ranges_to_points(
     ranges: ArrayLike,
     angles: ArrayLike,

@@ -45,7 +45,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ndtgrid import __version__, se2, sim
-from ndtgrid._core import NdtGrid, ranges_to_points
+from ndtgrid._core import NdtGrid, ranges_to_points, vector_extension
 from ndtgrid.evaluation import anchored_errors, pose_error
 from ndtgrid.odometry import Odometry
 
@@ -53,6 +53,7 @@ __all__ = [
     "MIN_SCANS",
     "BenchReport",
     "BenchRow",
+    "kernels_name",
     "max_scans",
     "pinnable_cpus",
     "processor_name",
@@ -211,7 +212,8 @@ class BenchReport:
         m = self.machine
         lines = [
             f"ndtgrid {m.get('ndtgrid', '?')} on {m.get('cores', '?')} cores of "
-            f"{m.get('processor', '?')}, Python {m.get('python', '?')}: "
+            f"{m.get('processor', '?')}, {m.get('kernels', '?')}, "
+            f"Python {m.get('python', '?')}: "
             f"{self.scans} simulated URG-04LX scans of {self.points} points, "
             f"2 cm cells ({self.map_cells} cells, {self.map_bytes_per_cell:.0f} B / cell).",
             "",
@@ -240,13 +242,29 @@ def _tour(room: sim.World) -> F64:
     return sim.trajectory(room.tour)
 
 
+#: Fields of ``/proc/cpuinfo`` that tell processors of one model name apart, with the
+#: label each gets: x86's family, model and stepping, ARM's implementer, part, variant
+#: and revision.
+_CPU_IDS = (
+    ("family", "cpu family"),
+    ("model", "model"),
+    ("stepping", "stepping"),
+    ("implementer", "CPU implementer"),
+    ("part", "CPU part"),
+    ("variant", "CPU variant"),
+    ("revision", "CPU revision"),
+)
+
+
 def processor_name(cpuinfo: str | None = None) -> str:
     """The processor, named so that two machines under one model name can be told apart.
 
     A virtual machine's ``model name`` can be as vague as ``AMD EPYC`` for several
-    generations of processor, whose speed on the same code differs by half
-    (``BENCHMARK.md``, "Speed", session 34), so the family, model and stepping follow
-    it, and the widest vector extension the core's kernels can pick at run time.
+    generations of processor, which ran the same code up to twice as fast as each other
+    (``BENCHMARK.md``, "Speed", session 34), and an ARM board's ``/proc/cpuinfo`` often
+    has no model name at all. So the processor's identifiers follow the name (x86:
+    family, model, stepping; ARM: implementer, part, variant, revision). The build of
+    the core's kernels that runs is :func:`ndtgrid._core.vector_extension`.
 
     Parameters
     ----------
@@ -257,8 +275,8 @@ def processor_name(cpuinfo: str | None = None) -> str:
     Returns
     -------
     str
-        For example ``"AMD EPYC (family 25, model 17, stepping 1; AVX-512)"``; the
-        fields the text lacks are left out, and without the text (not Linux) it is
+        For example ``"AMD EPYC (family 25, model 17, stepping 1)"``. The fields the
+        text lacks are left out; without a model name (ARM, or not Linux) the name is
         :func:`platform.processor` or :func:`platform.machine`.
     """
     if cpuinfo is None:
@@ -276,15 +294,20 @@ def processor_name(cpuinfo: str | None = None) -> str:
         key, _, value = line.partition(":")
         fields.setdefault(key.strip(), value.strip())
     name = fields.get("model name") or platform.processor() or platform.machine()
-    ids = [
-        f"{label} {fields[key]}"
-        for label, key in (("family", "cpu family"), ("model", "model"), ("stepping", "stepping"))
-        if fields.get(key)
-    ]
-    flags = set(fields.get("flags", "").split())
-    simd = next((n for f, n in (("avx512f", "AVX-512"), ("avx2", "AVX2")) if f in flags), None)
-    detail = "; ".join(x for x in (", ".join(ids), simd) if x)
-    return f"{name} ({detail})" if detail else name
+    ids = ", ".join(f"{label} {fields[key]}" for label, key in _CPU_IDS if fields.get(key))
+    return f"{name} ({ids})" if ids else name
+
+
+def kernels_name() -> str:
+    """The build of the core's kernels that runs here, for a report's machine line.
+
+    Returns
+    -------
+    str
+        ``"AVX-512 kernels"``, ``"AVX2 kernels"``, ``"NEON kernels"`` or ``"generic
+        kernels"`` (:func:`ndtgrid._core.vector_extension`).
+    """
+    return f"{vector_extension() or 'generic'} kernels"
 
 
 def _machine() -> dict[str, str]:
@@ -292,6 +315,7 @@ def _machine() -> dict[str, str]:
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     return {
         "processor": processor_name(),
+        "kernels": kernels_name(),
         "cores": str(cores),
         "python": platform.python_version(),
         "ndtgrid": __version__,

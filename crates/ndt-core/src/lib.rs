@@ -32,6 +32,7 @@ pub mod freespace;
 pub mod gather;
 pub mod grid;
 pub mod information;
+pub mod kernels;
 pub mod key;
 pub mod lanexp;
 mod many;

@@ -6,6 +6,7 @@ mod convert;
 mod errors;
 mod freespace;
 mod grid;
+mod kernels;
 mod mapper;
 mod mapper_options;
 mod match_options;
@@ -39,5 +40,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(se2::compose, m)?)?;
     m.add_function(wrap_pyfunction!(se2::inverse, m)?)?;
     m.add_function(wrap_pyfunction!(se2::between, m)?)?;
+    m.add_function(wrap_pyfunction!(kernels::vector_extension, m)?)?;
     Ok(())
 }
