@@ -275,6 +275,12 @@ def test_threads_none_counts_the_cpus_of_the_calling_thread() -> None:
     want = [exact(r) for r in grid.match_many(scans, guesses, threads=1)]
     # Unpinned: a helper, which the poller sees (so it would see one below).
     assert _helpers_seen(lambda: grid.match_many(scans, guesses))
+    # A joined helper may still be listed for a moment: wait until it is gone, so the
+    # poller below cannot see this call's helpers.
+    deadline = time.monotonic() + 5.0
+    while "ndtgrid-match" in _thread_names() and time.monotonic() < deadline:
+        time.sleep(0.001)
+    assert "ndtgrid-match" not in _thread_names()
     got: list[list[Any]] = []
 
     def pinned() -> None:
