@@ -129,7 +129,8 @@ class BenchReport:
     map_bytes_per_cell : float
         :meth:`ndtgrid.NdtGrid.memory_bytes` of that map over its cells.
     machine : dict of str to str
-        Processor, cores, Python and ndtgrid versions.
+        ``processor`` (:func:`processor_name`), ``kernels`` (:func:`kernels_name`),
+        ``cores``, ``python``, ``ndtgrid`` and ``platform``.
     """
 
     rows: tuple[BenchRow, ...]
@@ -311,7 +312,7 @@ def kernels_name() -> str:
 
 
 def _machine() -> dict[str, str]:
-    """Processor, cores, Python and ndtgrid versions of this machine."""
+    """Processor, kernels, cores, Python and ndtgrid versions of this machine."""
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     return {
         "processor": processor_name(),
