@@ -22,14 +22,20 @@ use std::thread;
 /// where that cannot be read (not Linux, or more CPUs than a mask holds).
 #[cfg(target_os = "linux")]
 pub(crate) fn caller_cpus() -> Option<usize> {
-    use nix::sched::{sched_getaffinity, CpuSet};
+    use nix::sched::sched_getaffinity;
     use nix::unistd::Pid;
     // Pid 0: the calling thread.
     let set = sched_getaffinity(Pid::from_raw(0)).ok()?;
-    let n = (0..CpuSet::count())
-        .filter(|&cpu| set.is_set(cpu).unwrap_or(false))
-        .count();
+    let n = cpus_in(&set);
     (n > 0).then_some(n)
+}
+
+/// The CPUs set in an affinity mask.
+#[cfg(target_os = "linux")]
+fn cpus_in(set: &nix::sched::CpuSet) -> usize {
+    (0..nix::sched::CpuSet::count())
+        .filter(|&cpu| set.is_set(cpu).unwrap_or(false))
+        .count()
 }
 
 /// The CPUs the calling thread may run on: unknown here.
@@ -132,13 +138,6 @@ mod tests {
         .unwrap();
         assert_eq!(pinned, (Some(1), 1));
         assert_eq!(threads_for_caller(), full);
-        assert_eq!(caller_cpus(), Some(mask_len(&mask)));
-    }
-
-    #[cfg(target_os = "linux")]
-    fn mask_len(mask: &nix::sched::CpuSet) -> usize {
-        (0..nix::sched::CpuSet::count())
-            .filter(|&c| mask.is_set(c).unwrap())
-            .count()
+        assert_eq!(caller_cpus(), Some(cpus_in(&mask)));
     }
 }

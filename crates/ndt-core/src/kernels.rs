@@ -31,7 +31,8 @@ impl VectorExtension {
 
 /// The vector extension of the kernels' build that runs here, `None` for
 /// the generic build. The targets are the kernels' own, in their order, so
-/// the choice is theirs.
+/// the choice is theirs (a test checks that the four lists are the same;
+/// a macro holding the list would keep rustfmt out of the kernels' bodies).
 #[multiversion(targets(
     "x86_64+avx512f+avx512dq+avx512vl+avx2+fma+avx",
     "x86_64+avx2+fma+avx",
@@ -53,6 +54,34 @@ pub fn vector_extension() -> Option<VectorExtension> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The `multiversion` targets of a source file, each attribute's list
+    /// (attributes at the start of a line).
+    fn targets(source: &str) -> Vec<&str> {
+        source
+            .split("\n#[multiversion(targets(")
+            .skip(1)
+            .filter_map(|rest| rest.split("))]").next())
+            .collect()
+    }
+
+    /// The kernels (`batch.rs`, `moments.rs`, `pairs.rs`) and
+    /// [`vector_extension`] have the same targets, in the same order, so the
+    /// build named is the one the kernels run.
+    #[test]
+    fn the_kernels_and_the_report_share_their_targets() {
+        let own = targets(include_str!("kernels.rs"));
+        assert_eq!(own.len(), 1);
+        for source in [
+            include_str!("batch.rs"),
+            include_str!("moments.rs"),
+            include_str!("pairs.rs"),
+        ] {
+            let theirs = targets(source);
+            assert!(!theirs.is_empty());
+            assert!(theirs.iter().all(|t| *t == own[0]), "{theirs:?} != {own:?}");
+        }
+    }
 
     /// The answer follows the processor's features as the standard library
     /// detects them, target by target in the kernels' order.
