@@ -39,6 +39,9 @@ as a Markdown table to stdout as soon as it is measured (progress goes to stderr
 6. **Memory**: bytes per occupied fine cell (RSS growth of a fresh child process divided by
    ``len(grid)``) before and after the distributions are built.
 
+Sections 1-3 are then drawn in one picture, ``docs/img/speed_peers.png`` when matplotlib
+is installed: every method's median match per case set with its success rate, every
+map's update of one scan, every loop's time over the Intel log with its relation error.
 A table of the issue's targets against this run's numbers closes the output.
 
 Run from the repository root (needs ``pip install -e ".[bench]"`` and
@@ -82,6 +85,7 @@ import convergence
 import datasets
 import peers as peer_lib
 import pinned
+import speed_plots
 
 import ndtgrid
 from ndtgrid import se2, sim
@@ -142,6 +146,16 @@ def no_gc() -> Iterator[None]:
 def out(lines: str | Sequence[str] = "") -> None:
     """Markdown to stdout, flushed (a section appears as soon as it is measured)."""
     print(lines if isinstance(lines, str) else "\n".join(lines), flush=True)
+
+
+def plotted(path: Path | None) -> None:
+    """Names a plot written at ``path`` in the output, or says that matplotlib is absent
+    (``path`` ``None``)."""
+    if path is None:
+        out("\n(matplotlib absent: no plot.)")
+        return
+    shown = path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
+    out(f"\nPlot: `{shown}`.")
 
 
 def ms(seconds: float) -> str:
@@ -352,7 +366,11 @@ def match_table(title: str, cases: list[convergence.Pair], runs: list[MethodRun]
             f"| {ratio(r.median, ours.median)} |"
         )
     peers = runs[1:]
-    res: dict[str, Any] = {"ours": ours.median, "ours_success": ours.hits / ours.n}
+    res: dict[str, Any] = {
+        "ours": ours.median,
+        "ours_success": ours.hits / ours.n,
+        "methods": [(r.name, r.median, r.hits / r.n) for r in runs],
+    }
     if peers:
         fastest = min(peers, key=lambda r: r.median)
         good = [r for r in peers if r.hits >= ours.hits]
@@ -666,7 +684,18 @@ def section_insert(args: argparse.Namespace) -> dict[str, Any]:
                 f"| {1e6 * med / np.median(npts):.3f} | {ratio(med, ours)} "
                 f"| {us(full) if t_pre else '-'} | {ratio(full, ours) if t_pre else '-'} |"
             )
-        res[title] = {"ours": ours, "points": float(np.median(npts))}
+        res[title] = {
+            "ours": ours,
+            "points": float(np.median(npts)),
+            "methods": [
+                (
+                    name,
+                    float(np.median(t_ins)),
+                    float(np.median(np.add(t_ins, t_pre))) if t_pre else math.nan,
+                )
+                for name, t_ins, t_pre in rows
+            ],
+        }
     return res
 
 
@@ -1022,6 +1051,7 @@ def section_odometry(args: argparse.Namespace) -> dict[str, Any]:
         "ours_one_thread": runs[1].seconds,
         "ours_poses_only": runs[2].seconds,
         "vmhwm_mib": info["vmhwm_kib"] * mib,
+        "methods": [(r.name, r.seconds, errors[r.name]) for r in runs],
     }
     if peers:
         fastest = min(peers, key=lambda r: r.seconds)
@@ -1224,118 +1254,8 @@ def section_sweeps(args: argparse.Namespace) -> dict[str, Any]:
                 f"{ratio(sub[-1]['median'], sub[0]['median'])} the time."
             )
     if args.plot:
-        plot_sweeps(res, Path(args.plot))
+        plotted(speed_plots.plot_sweeps(res, Path(args.plot)))
     return res
-
-
-def pyplot() -> Any:
-    """``matplotlib.pyplot`` with the Agg backend, or ``None`` (said in the output) when
-    matplotlib is absent."""
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        out("\n(matplotlib absent: no plot.)")
-        return None
-    return plt
-
-
-def save_figure(fig: Any, title: str, path: Path) -> None:
-    """Titles, lays out, writes (creating the directory) and closes ``fig``; names the
-    file in the output."""
-    import matplotlib.pyplot as plt
-
-    fig.suptitle(title)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    full = path.resolve()
-    shown = full.relative_to(ROOT) if full.is_relative_to(ROOT) else path
-    plt.close(fig)
-    out(f"\nPlot: `{shown}`.")
-
-
-def plot_sweeps(res: dict[str, Any], path: Path) -> None:
-    """The two sweeps as a PNG (skipped without matplotlib)."""
-    plt = pyplot()
-    if plt is None:
-        return
-    rows, slope, icpt, r2 = res["points"]
-    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
-    x = np.array([r["points"] for r in rows])
-    a.plot(x, [1e3 * r["median"] for r in rows], "o", label="median of the matches")
-    xs = np.linspace(0, x.max() * 1.05, 50)
-    a.plot(xs, 1e3 * (slope * xs + icpt), "-", label=f"linear fit (R² = {r2:.3f})")
-    a.set_xlabel("valid scan points")
-    a.set_ylabel("time per match [ms]")
-    a.set_title("Scan points (one 2 cm map, simulated URG-04LX)")
-    a.set_xlim(left=0)
-    a.set_ylim(bottom=0)
-    a.legend()
-    for kind, marker, label in (
-        ("recent", "o-", "map of the last k Intel scans"),
-        ("padded", "s-", "30 scans + far copies of the log"),
-    ):
-        sub = [r for r in res["map"] if r["kind"] == kind]
-        if sub:
-            b.plot([r["cells"] for r in sub], [1e3 * r["median"] for r in sub], marker, label=label)
-    b.set_xscale("log")
-    b.set_xlabel("occupied 2 cm cells in the map")
-    b.set_ylabel("time per match [ms]")
-    b.set_title("Map size (same Intel scans)")
-    b.set_ylim(bottom=0)
-    b.legend()
-    save_figure(fig, "ndtgrid default match() on a 2 cm grid, one thread (benches/speed.py)", path)
-
-
-def plot_threads(runs: dict[str, list[float]], path: Path) -> None:
-    """The thread section's runs as a PNG (skipped without matplotlib): each run's
-    ratio (one thread's time over two threads' right after it) for the unpinned threads
-    (marked where both were on one vCPU half-way through) and the pinned ones,
-    ``match_many`` and the two GIL-free controls; when the later thread began."""
-    plt = pyplot()
-    if plt is None:
-        return
-    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.8))
-    for key, marker, label in (
-        ("unpinned", "o", "two threads started per run"),
-        ("unpinned_one_cpu", "k.", "… on one vCPU half-way through"),
-        ("pinned", "s", "two pinned workers"),
-        ("sha", "x", "control: SHA-256 (GIL released)"),
-        ("bundles", "+", "control: 20-scan bundles"),
-        ("many", "D", "match_many, every core / one thread"),
-    ):
-        ys = runs.get(key, [])
-        if ys:
-            a.plot(np.arange(1, len(ys) + 1), ys, marker, label=label, alpha=0.85)
-    a.axhline(1.7, color="k", lw=0.8, ls="--", label="target 1.7×")
-    a.axhline(2.0, color="0.6", lw=0.8)
-    a.set_xlabel("run (one- and two-thread runs alternate)")
-    a.set_ylabel("one thread's time / two threads' time")
-    a.set_title("Speed-up per run")
-    a.xaxis.get_major_locator().set_params(integer=True)
-    a.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.16))
-    for key, marker, label in (
-        ("late_unpinned", "o", "started per run (after the clock)"),
-        ("late_pinned", "s", "pinned (after the first worker)"),
-    ):
-        ys = runs.get(key, [])
-        if ys:
-            b.plot(np.arange(1, len(ys) + 1), 1e3 * np.maximum(ys, 1e-6), marker, label=label)
-    b.axhline(4.0, color="k", lw=0.8, ls="--", label="scheduler tick (HZ = 250)")
-    b.set_yscale("log")
-    b.set_xlabel("run")
-    b.set_ylabel("later thread's first match began [ms]")
-    b.set_title("Late starts")
-    b.xaxis.get_major_locator().set_params(integer=True)
-    b.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))
-    save_figure(
-        fig,
-        "Matching different scans on two cores against one 2 cm map (benches/speed.py)",
-        path,
-    )
 
 
 # ----------------------------------------------------------------------------- 5. threads
@@ -1691,14 +1611,16 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         ]
     )
     if args.plot_threads:
-        plot_threads(
-            {
-                **per_run,
-                "sha": controls,
-                "late_unpinned": lates,
-                "late_pinned": pin_lates,
-            },
-            Path(args.plot_threads),
+        plotted(
+            speed_plots.plot_threads(
+                {
+                    **per_run,
+                    "sha": controls,
+                    "late_unpinned": lates,
+                    "late_pinned": pin_lates,
+                },
+                Path(args.plot_threads),
+            )
         )
     return {
         "ratio": s2 / s1,
@@ -1974,6 +1896,11 @@ def main() -> int:
         help="thread plot path (default docs/img/speed_threads.png; none with --quick unless "
         "given)",
     )
+    ap.add_argument(
+        "--plot-peers",
+        help="picture of sections 1-3, ours against the peers (default "
+        "docs/img/speed_peers.png; none with --quick unless given)",
+    )
     ap.add_argument("--intel-child", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--one-thread", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--poses-only", action="store_true", help=argparse.SUPPRESS)
@@ -1997,6 +1924,8 @@ def main() -> int:
         args.plot = str(ROOT / "docs" / "img" / "speed_sweeps.png")
     if args.plot_threads is None and not q:
         args.plot_threads = str(ROOT / "docs" / "img" / "speed_threads.png")
+    if args.plot_peers is None and not q:
+        args.plot_peers = str(ROOT / "docs" / "img" / "speed_peers.png")
     args.sweep_points = [100, 683, 2000] if q else [100, 200, 400, 683, 1000, 2000, 4000]
     args.sweep_maps = 3 if q else 8
     args.sweep_tests = 5 if q else 20
@@ -2040,6 +1969,9 @@ def main() -> int:
             gc.collect()
             res[name] = runners[name](args)
             log(f"section {name}: {time.perf_counter() - t0:.0f} s")
+    if args.plot_peers and res.keys() & {"match", "insert", "odometry"}:
+        out("\n## Ours against the peers, in one picture")
+        plotted(speed_plots.plot_peers(res, Path(args.plot_peers), datasets.machine()))
     targets(res)
     total = time.perf_counter() - start
     out(f"\nWhole run: {total / 60:.1f} min; load average at the end {os.getloadavg()[0]:.2f}.")
