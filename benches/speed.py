@@ -676,26 +676,17 @@ def section_insert(args: argparse.Namespace) -> dict[str, Any]:
             ]
         )
         ours = float(np.median(rows[0][1]))
+        methods = []
         for name, t_ins, t_pre in rows:
             med = float(np.median(t_ins))
             full = float(np.median(np.add(t_ins, t_pre))) if t_pre else math.nan
+            methods.append((name, med, full))
             out(
                 f"| {name} | {us(med)} | {us(float(np.percentile(t_ins, 90)))} "
                 f"| {1e6 * med / np.median(npts):.3f} | {ratio(med, ours)} "
                 f"| {us(full) if t_pre else '-'} | {ratio(full, ours) if t_pre else '-'} |"
             )
-        res[title] = {
-            "ours": ours,
-            "points": float(np.median(npts)),
-            "methods": [
-                (
-                    name,
-                    float(np.median(t_ins)),
-                    float(np.median(np.add(t_ins, t_pre))) if t_pre else math.nan,
-                )
-                for name, t_ins, t_pre in rows
-            ],
-        }
+        res[title] = {"ours": ours, "points": float(np.median(npts)), "methods": methods}
     return res
 
 

@@ -146,18 +146,22 @@ class Bar:
     """One row of a ``speed.py`` table as the peers' picture draws it.
 
     ``group``: the case set (match, map update) or ``""`` (odometry); ``method``: the
-    row's name without Markdown; ``library``: one of :data:`LIBRARIES` (or ``"other"``);
-    ``seconds``: the median time (odometry: the whole run); ``extra``: the map update
-    with the peer's preprocessing of the scan (``nan`` where there is none); ``note``:
-    the match's success rate or the odometry's relation error.
+    row's name without Markdown; ``seconds``: the median time (odometry: the whole
+    run); ``extra``: the map update with the peer's preprocessing of the scan (``nan``
+    where there is none); ``note``: the match's success rate or the odometry's relation
+    error.
     """
 
     group: str
     method: str
-    library: str
     seconds: float
     extra: float = math.nan
     note: str = ""
+
+    @property
+    def library(self) -> str:
+        """One of :data:`LIBRARIES`, by the start of the method's name (or ``"other"``)."""
+        return library_of(self.method)
 
 
 def library_of(name: str) -> str:
@@ -175,17 +179,17 @@ def peer_bars(res: dict[str, dict[str, Any]]) -> dict[str, list[Bar]]:
     ``res``, by section) as bars: ``{"match": …, "insert": …, "odometry": …}``, each in
     the tables' order; a section that did not run gives an empty list."""
     match = [
-        Bar(title, plain(name), library_of(name), median, note=f"{100 * success:.0f} %")
+        Bar(title, plain(name), median, note=f"{100 * success:.0f} %")
         for key, title in MATCH_SETS
         for name, median, success in res.get("match", {}).get(key, {}).get("methods", [])
     ]
     insert = [
-        Bar(re.sub(r" \(.*\)$", "", title), plain(name), library_of(name), median, extra)
+        Bar(re.sub(r" \(.*\)$", "", title), plain(name), median, extra)
         for title, rows in res.get("insert", {}).items()
         for name, median, extra in rows.get("methods", [])
     ]
     odometry = [
-        Bar("", plain(name), library_of(name), seconds, note=f"{error:.3f} m")
+        Bar("", plain(name), seconds, note=f"{error:.3f} m")
         for name, seconds, error in res.get("odometry", {}).get("methods", [])
     ]
     return {"match": match, "insert": insert, "odometry": odometry}
@@ -234,9 +238,10 @@ def _grouped(ax: Any, bars: list[Bar], scale: float, unit: str) -> None:
             fontsize=6,
         )
 
+    by_key = {(b.group, b.method): b for b in bars}
     for i, g in enumerate(groups):
         for j, m in enumerate(methods):
-            b = next((b for b in bars if b.group == g and b.method == m), None)
+            b = by_key.get((g, m))
             if b is None or not math.isfinite(b.seconds):
                 continue
             x = i - 0.42 + width * (j + 0.5)

@@ -3,28 +3,17 @@
 
 from __future__ import annotations
 
-import importlib.util
 import os
 import threading
-from pathlib import Path
-from types import ModuleType
 
 import numpy as np
 import pytest
 
 import ndtgrid
 
+from ._benches import load_bench
 
-def load_pinned() -> ModuleType:
-    path = Path(__file__).resolve().parents[1] / "benches" / "pinned.py"
-    spec = importlib.util.spec_from_file_location("bench_pinned", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-pinned = load_pinned()
+pinned = load_bench("pinned")
 CPUS = pinned.two_cpus()
 needs_two = pytest.mark.skipif(CPUS is None, reason="needs os.sched_setaffinity and two CPUs")
 

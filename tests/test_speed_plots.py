@@ -3,28 +3,15 @@ the match, map update and odometry tables it draws, and the file it writes."""
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
 from pathlib import Path
-from types import ModuleType
 from typing import Any
 
 import pytest
 
+from ._benches import load_bench
 
-def load_speed_plots() -> ModuleType:
-    path = Path(__file__).resolve().parents[1] / "benches" / "speed_plots.py"
-    spec = importlib.util.spec_from_file_location("bench_speed_plots", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    # Registered first: its dataclass looks its module up by name.
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-plots = load_speed_plots()
+plots = load_bench("speed_plots")
 
 # The results of speed.py's first three sections, in the shapes it returns them.
 RESULTS: dict[str, dict[str, Any]] = {
