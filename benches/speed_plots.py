@@ -170,8 +170,8 @@ def library_of(name: str) -> str:
 
 
 def plain(name: str) -> str:
-    """A row's name without Markdown code marks and without the map's cell count."""
-    return re.sub(r" \(\d+ cells at the end\)", "", name.replace("`", ""))
+    """A row's name without Markdown code marks."""
+    return name.replace("`", "")
 
 
 def peer_bars(res: dict[str, dict[str, Any]]) -> dict[str, list[Bar]]:
