@@ -573,6 +573,10 @@ def section_match(args: argparse.Namespace) -> dict[str, Any]:
 # ----------------------------------------------------------------------------- 2. insert
 
 
+#: Scans per ``insert_many`` call in section 2.
+BATCH = 16
+
+
 def insert_set(
     name: str, pts: list[F64], poses: F64, prefill: int, count: int
 ) -> tuple[list[tuple[str, list[float], list[float]]], int]:
@@ -592,6 +596,23 @@ def insert_set(
             grid.insert(pts[j], poses[j])
             times.append(time.perf_counter() - t0)
     rows.append(("ndtgrid `NdtGrid(0.02).insert`", times, []))
+    # The same scans in batches of BATCH through insert_many, into a map of the same
+    # prefill; each batch's first scan matched first (untimed), each batch's time
+    # divided by its scans: one sample per batch.
+    batched = ndtgrid.NdtGrid(CELL)
+    for j in range(prefill):
+        batched.insert(pts[j], poses[j])
+    per_scan: list[float] = []
+    starts = range(prefill, n - BATCH + 1, BATCH)
+    for j in progress(starts, f"{name}: ndtgrid insert_many"):
+        batched.match(pts[j], poses[j])
+        with no_gc():
+            t0 = time.perf_counter()
+            batched.insert_many(pts[j : j + BATCH], poses[j : j + BATCH])
+            per_scan.append((time.perf_counter() - t0) / BATCH)
+    rows.append(
+        (f"ndtgrid `NdtGrid(0.02).insert_many`, batches of {BATCH} (per scan)", per_scan, [])
+    )
     try:
         import small_gicp
     except ImportError:
@@ -645,6 +666,10 @@ def section_insert(args: argparse.Namespace) -> dict[str, Any]:
         f"Each map first holds {args.prefill} scans; then each next scan is inserted and "
         "timed (one thread). Ours: before every insert the scan is matched (untimed), so "
         "the distributions are built, as in a SLAM loop; the insert keeps them up to date. "
+        f"Our second row takes the same scans {BATCH} at a time through `insert_many` (the "
+        "batch's first scan matched first, untimed), which brings the coarser levels and "
+        "the distributions up to date once per batch: its time per scan, one sample per "
+        "batch; the issue's 50 µs target is judged on the first row. "
         "small_gicp's `GaussianVoxelMap.insert` needs the scan as a `PointCloud` with "
         "per-point covariances: its `preprocess_points` (3-layer lift, 1 cm merge, "
         "10 neighbours) is timed separately and added in the last columns. KISS-ICP's "

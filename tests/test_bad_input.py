@@ -234,6 +234,12 @@ CASES: list[tuple[str, Callable[[ndtgrid.NdtGrid], Any], type[Exception], str]] 
         "pose: expected finite values, got NaN at index 1",
     ),
     (
+        "pose inf",
+        lambda g: g.insert(GOOD, [0.0, 0.0, np.inf]),
+        ValueError,
+        "pose: expected finite values, got inf at index 2",
+    ),
+    (
         "guess inf",
         lambda g: g.match(GOOD, [0.0, 0.0, np.inf]),
         ValueError,

@@ -51,6 +51,7 @@ def test_rows_are_the_timed_operations_with_consistent_numbers(
     names = [r.name for r in report.rows]
     assert names == [
         "insert",
+        f"insert_many, batches of {bench.INSERT_BATCH}",
         "match",
         "match_many, one thread",
         "match_many, every core",
@@ -61,7 +62,8 @@ def test_rows_are_the_timed_operations_with_consistent_numbers(
     ]
     calls = {r.name: r.calls for r in report.rows}
     assert calls["insert"] == SCANS - bench.UNTIMED_INSERTS
-    assert all(calls[n] == SCANS for n in names[1:])
+    assert calls[names[1]] == -(-SCANS // bench.INSERT_BATCH)
+    assert all(calls[n] == SCANS for n in names[2:])
     batches = {n for n in names if n.startswith("match_many") or "Python" in n}
     for r in report.rows:
         assert r.median > 0.0, r.name
@@ -87,6 +89,13 @@ def test_rows_are_the_timed_operations_with_consistent_numbers(
         lo, hi = map(float, rows[other].note.split("(")[1].removesuffix(" by round)").split(" to "))
         assert lo <= hi
         assert f"; {speedup:.2f} x {label} (" in rows[other].note
+
+
+def test_the_batched_map_is_checked_against_the_inserts(report: bench.BenchReport) -> None:
+    rows = {r.name: r for r in report.rows}
+    assert rows[f"insert_many, batches of {bench.INSERT_BATCH}"].note == (
+        "per scan, one call per batch; the map equals insert's, bit for bit"
+    )
 
 
 def test_the_map_is_the_one_the_scans_make(report: bench.BenchReport) -> None:
@@ -166,7 +175,7 @@ def test_the_kernels_named_are_those_the_core_runs_and_the_flags_allow() -> None
 def test_report_as_json_and_table(report: bench.BenchReport) -> None:
     data = json.loads(json.dumps(report.as_dict()))
     assert data["scans"] == SCANS and len(data["rows"]) == len(report.rows)
-    assert data["rows"][1]["name"] == "match"
+    assert data["rows"][2]["name"] == "match"
     assert data["match_many_speedup"] == report.match_many_speedup
     assert data["python_threads_speedup"] == report.python_threads_speedup
     assert data["pinned_threads_speedup"] == report.pinned_threads_speedup
@@ -188,8 +197,8 @@ def test_report_as_json_and_table(report: bench.BenchReport) -> None:
     assert f"{SCANS} simulated URG-04LX scans" in table[0]
     assert table[2] == "| operation | median | p90 | calls | checked |"
     assert len(table) == 4 + len(report.rows)
-    assert table[6].startswith("| match_many, one thread | ") and " | - | " in table[6]
-    assert table[8].startswith("| match, 1 Python thread | ")
+    assert table[7].startswith("| match_many, one thread | ") and " | - | " in table[7]
+    assert table[9].startswith("| match, 1 Python thread | ")
 
 
 def test_no_pinned_row_where_threads_cannot_be_pinned(monkeypatch: pytest.MonkeyPatch) -> None:

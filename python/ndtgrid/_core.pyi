@@ -126,8 +126,9 @@ class NdtGrid:
     Thread safety: many readers, one exclusive writer. Any number of threads
     may call :meth:`match`, :meth:`evaluate`, :meth:`cells`,
     :meth:`cell_states` at once (the GIL is released while they run);
-    :meth:`insert` waits for them and runs alone. A match sees the map as it
-    was between two inserts, never half an insert, and its result is bit for
+    :meth:`insert` and :meth:`insert_many` wait for them and run alone. A match
+    sees the map as it was between two inserts (or batches of
+    :meth:`insert_many`), never half of one, and its result is bit for
     bit that of matching that state alone (distributions are prepared lazily
     but are a function of the cells' sums only). Every method either succeeds
     or leaves the map unchanged.
@@ -169,6 +170,39 @@ class NdtGrid:
             On a wrong shape, a NaN or infinite value, or a point whose cell
             index would overflow (``|coordinate| >= 2**30 * cell_size``). The
             map is unchanged after any error.
+        """
+    def insert_many(self, scans: Sequence[ArrayLike], poses: ArrayLike) -> None:
+        """Add many scans to the map in one call (eq. 6 for each, in order).
+
+        The map afterwards is, bit for bit, the one that :meth:`insert` gives
+        scan by scan, but the coarser pyramid levels and the distributions
+        prepared for matching are brought up to date once for the whole batch
+        instead of after every scan. Consecutive scans of a log see mostly the
+        same surfaces, so that upkeep, most of a single insert's work, is
+        shared: building a map from a log whose poses are known (ground truth,
+        a finished SLAM run, an optimised trajectory) takes less time per scan
+        the longer the batch (BENCHMARK.md, "Speed", session 37). The GIL is
+        released once for the whole batch; matches wait for it to finish.
+
+        Parameters
+        ----------
+        scans : sequence of array_like, shape (N_i, 2)
+            Scan-frame points [m] of each scan (a list of arrays, or one array
+            of shape (K, N, 2)); a scan with ``N_i = 0`` adds nothing.
+        poses : array_like, shape (K, 3)
+            ``[x, y, theta]`` (m, m, rad) of each scan in the map frame, one row
+            per scan.
+
+        Raises
+        ------
+        TypeError
+            If ``scans`` is not a sequence of arrays (one ``(N, 2)`` array is one
+            scan: use :meth:`insert`) or an argument holds non-real numbers.
+        ValueError
+            On a number of poses other than one per scan, a wrong shape, or a
+            scan :meth:`insert` would reject: the message names the first such
+            scan (``"scan 3: points: ..."``). Every scan is checked before the
+            map changes, so after any error the map is unchanged.
         """
     def match(
         self,

@@ -12,6 +12,9 @@ included; one call at a time on the calling thread unless said otherwise):
   that holds the scans before it. As in a SLAM loop, the map's distributions are prepared
   (by an untimed :meth:`~ndtgrid.NdtGrid.match` before each insert), so each insert also
   keeps them up to date.
+- ``insert_many``: the same scans into a second map, :data:`INSERT_BATCH` at a time by
+  :meth:`ndtgrid.NdtGrid.insert_many` (each batch's first scan matched first, untimed),
+  per scan; the row checks that this map equals the first one bit for bit.
 - ``match``: :meth:`ndtgrid.NdtGrid.match` of each scan against the finished map, from its
   true pose moved by 3 cm, -2 cm and 1 degree.
 - ``match_many``: the same matches in one :meth:`~ndtgrid.NdtGrid.match_many` call, on one
@@ -74,6 +77,8 @@ RECOVERED = (0.01, math.radians(0.2))
 ODOMETRY_DRIFT = 0.02
 #: Inserts before the timed ones (the map first holds a few scans).
 UNTIMED_INSERTS = 10
+#: Scans per :meth:`~ndtgrid.NdtGrid.insert_many` call of the ``insert_many`` row.
+INSERT_BATCH = 16
 #: The row of two Python threads, each pinned to its own CPU.
 PINNED_ROW = "match, 2 Python threads, pinned"
 
@@ -437,8 +442,8 @@ def run_bench(
     repeats: int = 5,
     progress: Callable[[Iterable[Any], str, int], Iterator[Any]] | None = None,
 ) -> BenchReport:
-    """Time insert, match (alone, by ``match_many`` and from Python threads) and the
-    odometry loop on simulated scans.
+    """Time insert (one scan a call, and batches by ``insert_many``), match (alone, by
+    ``match_many`` and from Python threads) and the odometry loop on simulated scans.
 
     Parameters
     ----------
@@ -502,6 +507,26 @@ def run_bench(
         if i >= min(UNTIMED_INSERTS, scans // 2):
             insert_ns.append(dt)
     rows.append(_row("insert", "µs", insert_ns, f"map of up to {scans} scans"))
+
+    batched = NdtGrid(CELL_SIZE)
+    per_scan_ns: list[int] = []
+    for start in range(0, scans, INSERT_BATCH):
+        stop = min(start + INSERT_BATCH, scans)
+        if start > 0:
+            batched.match(points[start], truth[start])  # untimed, as above
+        t0 = time.perf_counter_ns()
+        batched.insert_many(points[start:stop], truth[start:stop])
+        per_scan_ns.append((time.perf_counter_ns() - t0) // (stop - start))
+    same = [a.tobytes() for a in batched.cell_states()] == [a.tobytes() for a in grid.cell_states()]
+    rows.append(
+        _row(
+            f"insert_many, batches of {INSERT_BATCH}",
+            "µs",
+            per_scan_ns,
+            f"per scan, one call per batch; the map {'equals' if same else 'DIFFERS FROM'} "
+            "insert's, bit for bit",
+        )
+    )
 
     guesses = _guesses(truth)
     match_ns: list[int] = []

@@ -92,7 +92,8 @@ def build_parser() -> argparse.ArgumentParser:
         "bench",
         help="time insert, match and the odometry loop on this machine (no data needed)",
         description="Time the installed library on simulated URG-04LX scans of the sticks "
-        "room: insert into a 2 cm map, match (checked against the truth), match_many on "
+        "room: insert into a 2 cm map (one scan a call, and in batches by insert_many, "
+        "checked to give the same map), match (checked against the truth), match_many on "
         "one thread and on every core, one and two Python threads matching (on Linux also "
         "two pinned ones), and the odometry loop. No data or other library "
         "is needed; benches/speed.py in the source tree compares peers on real logs.",

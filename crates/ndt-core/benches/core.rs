@@ -14,7 +14,8 @@
 //! pyramid's sums only), `pyramid_update` is the pyramid's part of that; both
 //! insert into a map that has taken one insert since it was built, and each
 //! timed insert goes to a fresh clone of it; `insert_loop` inserts into one
-//! grid scan after scan, each scan matched first (untimed), as a loop does.
+//! grid scan after scan, each scan matched first (untimed), as a loop does;
+//! `insert_many` inserts batches of that loop's scans in one call each.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -96,13 +97,7 @@ fn bench_insert_loop(c: &mut Criterion) {
     let mut group = c.benchmark_group("insert_loop");
     for beams in BEAMS {
         let mut grid = map(beams, 0.02);
-        let ring: Vec<(Pose2, Vec<[f64; 2]>)> = (0..64u32)
-            .map(|i| {
-                let a = f64::from(i) * std::f64::consts::TAU / 64.0;
-                let pose = Pose2::new(1.2 * a.cos(), 0.8 * a.sin(), a + 1.57);
-                (pose, scan(beams, pose, 100 + u64::from(i)))
-            })
-            .collect();
+        let ring = ring(beams);
         let options = MatchOptions::default();
         let mean = ring.iter().map(|(_, p)| p.len()).sum::<usize>() / ring.len();
         group.throughput(Throughput::Elements(mean as u64));
@@ -118,6 +113,52 @@ fn bench_insert_loop(c: &mut Criterion) {
                     let changed = grid.insert(black_box(pts), *pose);
                     timed += t.elapsed();
                     black_box(changed).unwrap_or_else(|e| panic!("{e}"));
+                }
+                timed
+            })
+        });
+    }
+    group.finish();
+}
+
+/// 64 scans from a ring of poses through the room, 0.1 rad and about 0.1 m
+/// apart, each with its pose.
+fn ring(beams: usize) -> Vec<(Pose2, Vec<[f64; 2]>)> {
+    (0..64u32)
+        .map(|i| {
+            let a = f64::from(i) * std::f64::consts::TAU / 64.0;
+            let pose = Pose2::new(1.2 * a.cos(), 0.8 * a.sin(), a + 1.57);
+            (pose, scan(beams, pose, 100 + u64::from(i)))
+        })
+        .collect()
+}
+
+/// `NdtGrid::insert_many`: batches of 1, 4, 16 and 64 consecutive 683-point
+/// scans of `insert_loop`'s ring in one call each, into one grid, matched
+/// first (untimed) so its distributions are built; throughput in scan
+/// points, so that a batch's rate compares with `insert_loop`'s.
+fn bench_insert_many(c: &mut Criterion) {
+    let mut group = c.benchmark_group("insert_many");
+    let mut grid = map(683, 0.02);
+    let ring = ring(683);
+    let options = MatchOptions::default();
+    for size in [1usize, 4, 16, 64] {
+        let points: usize = ring.iter().take(size).map(|(_, p)| p.len()).sum();
+        group.throughput(Throughput::Elements(points as u64));
+        let mut next = 0usize;
+        group.bench_function(BenchmarkId::new("cell_2cm_683", size), |b| {
+            b.iter_custom(|iters| {
+                let mut timed = std::time::Duration::ZERO;
+                for _ in 0..iters {
+                    let batch: Vec<_> = (0..size).map(|k| &ring[(next + k) % ring.len()]).collect();
+                    next += size;
+                    let (scans, poses): (Vec<&[[f64; 2]]>, Vec<Pose2>) =
+                        batch.iter().map(|(pose, p)| (p.as_slice(), *pose)).unzip();
+                    let _ = grid.match_scan(scans[0], poses[0], &options);
+                    let t = std::time::Instant::now();
+                    let done = grid.insert_many(black_box(&scans), &poses);
+                    timed += t.elapsed();
+                    done.unwrap_or_else(|e| panic!("{e}"));
                 }
                 timed
             })
@@ -226,7 +267,7 @@ fn bench_large(c: &mut Criterion) {
 }
 
 /// 64 different 683-point scans, each 3 cm / 1° off, in one `match_many`
-/// call: on the calling thread and on rayon's pool (every core).
+/// call: on the calling thread alone and with helper threads on every core.
 fn bench_many(c: &mut Criterion) {
     let mut group = c.benchmark_group("match_many");
     group.sample_size(20);
@@ -255,6 +296,7 @@ criterion_group!(
     benches,
     bench_insert,
     bench_insert_loop,
+    bench_insert_many,
     bench_pyramid,
     bench_match,
     bench_large,

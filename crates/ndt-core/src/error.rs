@@ -203,16 +203,20 @@ pub enum NdtError {
         /// Batches of scans lost.
         batches: usize,
     },
-    /// A batch of scans ([`crate::NdtGrid::match_many`]) with a number of
-    /// guesses other than one per scan.
-    #[error("guesses: expected {expected} poses (one per scan), got {got}")]
-    GuessCount {
+    /// A batch of scans ([`crate::NdtGrid::match_many`],
+    /// [`crate::NdtGrid::insert_many`]) with a number of poses other than one
+    /// per scan.
+    #[error("{what}: expected {expected} poses (one per scan), got {got}")]
+    PoseCount {
+        /// Which argument held the poses (`guesses`, `poses`).
+        what: &'static str,
         /// The number of scans.
         expected: usize,
-        /// The number of guesses.
+        /// The number of poses.
         got: usize,
     },
-    /// An error about scan `index` of a batch ([`crate::NdtGrid::match_many`]).
+    /// An error about scan `index` of a batch ([`crate::NdtGrid::match_many`],
+    /// [`crate::NdtGrid::insert_many`]).
     #[error("scan {index}: {error}")]
     InScan {
         /// Position of the scan in the batch.
@@ -287,5 +291,27 @@ pub(crate) fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {
             value: values[index],
         }),
         None => Ok(()),
+    }
+}
+
+/// Fails with [`NdtError::PoseCount`] unless there is one pose (`what`)
+/// per scan of a batch.
+pub(crate) fn check_pose_count(what: &'static str, scans: usize, poses: usize) -> Result<()> {
+    if poses == scans {
+        Ok(())
+    } else {
+        Err(NdtError::PoseCount {
+            what,
+            expected: scans,
+            got: poses,
+        })
+    }
+}
+
+/// The error of scan `index` of a batch, as [`NdtError::InScan`].
+pub(crate) fn in_scan(index: usize) -> impl Fn(NdtError) -> NdtError {
+    move |error| NdtError::InScan {
+        index,
+        error: Box::new(error),
     }
 }

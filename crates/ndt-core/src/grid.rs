@@ -17,6 +17,7 @@ use crate::table::CellTable;
 
 mod deferral;
 mod edit;
+mod insert_many;
 mod removals;
 
 pub use edit::MAX_CELL_COUNT;

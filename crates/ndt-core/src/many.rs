@@ -20,7 +20,7 @@ use std::any::Any;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::thread;
 
-use crate::error::{NdtError, Result};
+use crate::error::{check_pose_count, in_scan, NdtError, Result};
 use crate::grid::NdtGrid;
 use crate::matcher::{check_phases, MatchOptions, MatchResult};
 use crate::se2::Pose2;
@@ -35,7 +35,7 @@ impl NdtGrid {
     /// 1` helpers, at most one thread per two scans.
     /// `None`: one per CPU the calling thread may run on (as
     /// [`std::thread::available_parallelism`] counts them for it: its CPU
-    /// affinity and the cgroup's quota; see [`crate::affinity`]), since the
+    /// affinity and the cgroup's quota; see the crate's `affinity` module), since the
     /// helpers inherit the caller's affinity; `Some(1)`: the calling thread
     /// alone. A helper the system refuses to start leaves its share to the
     /// others.
@@ -64,18 +64,7 @@ impl NdtGrid {
                 value: 0.0,
             });
         }
-        if guesses.len() != scans.len() {
-            return Err(NdtError::GuessCount {
-                expected: scans.len(),
-                got: guesses.len(),
-            });
-        }
-        let in_scan = |index: usize| {
-            move |error: NdtError| NdtError::InScan {
-                index,
-                error: Box::new(error),
-            }
-        };
+        check_pose_count("guesses", scans.len(), guesses.len())?;
         for (index, (points, guess)) in scans.iter().zip(guesses).enumerate() {
             self.check_scan(points, *guess).map_err(in_scan(index))?;
         }

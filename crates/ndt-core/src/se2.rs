@@ -16,8 +16,13 @@ pub struct Pose2 {
     pub theta: f64,
 }
 
-/// Wraps an angle to (−π, π] \[rad\].
+/// Wraps an angle to (−π, π] \[rad\]. A NaN or infinite angle is returned
+/// as it is, so that the checks that reject it name the value given (an
+/// infinite angle wrapped would be NaN).
 pub fn wrap_angle(theta: f64) -> f64 {
+    if !theta.is_finite() {
+        return theta;
+    }
     let two_pi = 2.0 * std::f64::consts::PI;
     let mut a = theta.rem_euclid(two_pi);
     if a > std::f64::consts::PI {
@@ -97,5 +102,30 @@ impl Pose2 {
     /// (`self⁻¹ ∘ other`), as odometry increments are.
     pub fn between(self, other: Pose2) -> Pose2 {
         self.inverse().compose(other)
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn angles_wrap_to_the_half_open_interval_and_non_finite_ones_stay() {
+        assert_eq!(wrap_angle(0.5), 0.5);
+        assert_eq!(wrap_angle(PI), PI);
+        assert_eq!(wrap_angle(-PI), PI);
+        assert!((wrap_angle(3.0 * PI + 0.25) - (-PI + 0.25)).abs() < 1e-12);
+        assert!((wrap_angle(-7.0) - (-7.0 + 2.0 * PI)).abs() < 1e-12);
+        assert_eq!(wrap_angle(f64::INFINITY), f64::INFINITY);
+        assert_eq!(wrap_angle(f64::NEG_INFINITY), f64::NEG_INFINITY);
+        assert!(wrap_angle(f64::NAN).is_nan());
+        // So the check of a pose names the value given.
+        let err = Pose2::try_from_slice("pose", &[0.0, 0.0, f64::INFINITY]).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "pose: expected finite values, got inf at index 2"
+        );
     }
 }

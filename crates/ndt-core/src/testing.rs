@@ -16,3 +16,53 @@ pub(crate) fn random_symmetric(rng: &mut StdRng, eigenvalues: [f64; 3]) -> Matri
         q.matrix() * Matrix3::from_diagonal(&Vector3::from(eigenvalues)) * q.matrix().transpose();
     (m + m.transpose()) * 0.5
 }
+
+/// The distribution options the grids' tests prepare and compare: shaped
+/// fine levels (the match's default) and every level on its own (the
+/// odometry loop's).
+pub(crate) const GRID_OPTIONS: [crate::distributions::DistOptions; 2] = [
+    crate::distributions::DistOptions {
+        expansion: 10.0,
+        fuse_minority: true,
+        sigma_floor: 0.02,
+        shape_cell: 0.32,
+    },
+    crate::distributions::DistOptions {
+        expansion: 30.0,
+        fuse_minority: true,
+        sigma_floor: 0.01,
+        shape_cell: 0.0,
+    },
+];
+
+/// Every level's sums and the distributions of every [`GRID_OPTIONS`] of
+/// `a` and `b` are equal, bit for bit (the distributions are built where
+/// not yet prepared).
+#[allow(clippy::unwrap_used)]
+pub(crate) fn assert_same_grids(a: &crate::NdtGrid, b: &crate::NdtGrid) {
+    for l in 0..a.levels() {
+        let cells = |g: &crate::NdtGrid| {
+            let mut v: Vec<_> = g
+                .level(l)
+                .unwrap()
+                .cells()
+                .iter()
+                .map(|(k, c)| (k, *c))
+                .collect();
+            v.sort_unstable_by_key(|(k, _)| *k);
+            v
+        };
+        let (ca, cb) = (cells(a), cells(b));
+        assert_eq!(ca, cb, "level {l}");
+        for options in GRID_OPTIONS {
+            let (da, db) = (
+                a.distributions(l, options).unwrap(),
+                b.distributions(l, options).unwrap(),
+            );
+            assert_eq!(da.len(), db.len(), "level {l}");
+            for (k, _) in &ca {
+                assert_eq!(da.get(*k), db.get(*k), "level {l} cell {k:?}");
+            }
+        }
+    }
+}

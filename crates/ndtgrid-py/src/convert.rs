@@ -27,6 +27,11 @@ impl Points<'_> {
         bytemuck::try_cast_slice(flat)
             .map_err(|e| PyValueError::new_err(format!("points: cannot view as (N, 2): {e}")))
     }
+
+    /// Each of `sets` as `[x, y]` pairs ([`Points::as_pairs`]).
+    pub fn all_pairs<'a>(sets: &'a [Points<'_>]) -> PyResult<Vec<&'a [[f64; 2]]>> {
+        sets.iter().map(Points::as_pairs).collect()
+    }
 }
 
 fn shape_text(shape: &[usize]) -> String {
@@ -125,14 +130,19 @@ pub fn points<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Points<'py>>
 
 /// Validates and borrows a sequence named `what` of `(N, 2)` points (a list
 /// of arrays, or one array of shape `(K, N, 2)`); item `i` is named `scan i:
-/// points` in errors.
-pub fn point_sets<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Vec<Points<'py>>> {
-    if let Ok(one) = obj.cast::<PyUntypedArray>() {
-        if one.ndim() < 3 {
+/// points` in errors, and one `(N, 2)` array is pointed to the method `one`
+/// that takes a single scan.
+pub fn point_sets<'py>(
+    obj: &Bound<'py, PyAny>,
+    what: &str,
+    one: &str,
+) -> PyResult<Vec<Points<'py>>> {
+    if let Ok(array) = obj.cast::<PyUntypedArray>() {
+        if array.ndim() < 3 {
             return Err(PyTypeError::new_err(format!(
                 "{what}: expected a sequence of (N, 2) arrays, got one array of shape {} \
-                 (one scan: use match)",
-                shape_text(one.shape())
+                 (one scan: use {one})",
+                shape_text(array.shape())
             )));
         }
     }

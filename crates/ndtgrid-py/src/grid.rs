@@ -13,7 +13,9 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyType};
 
-use crate::convert::{count, level_mask, mat3, point_sets, points, pose, poses, rows, vec3};
+use crate::convert::{
+    count, level_mask, mat3, point_sets, points, pose, poses, rows, vec3, Points,
+};
 use crate::errors::{poisoned, to_py};
 use crate::match_options::options_from_kwargs;
 use crate::result::PyMatchResult;
@@ -119,6 +121,27 @@ impl PyNdtGrid {
         })
     }
 
+    /// eq. (6) for many scans in one call: the coarser levels and prepared
+    /// distributions brought up to date once (see the core's `insert_many`).
+    fn insert_many(
+        &self,
+        py: Python<'_>,
+        scans: &Bound<'_, PyAny>,
+        poses: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        let arrays = point_sets(scans, "scans", "insert")?;
+        let pairs = Points::all_pairs(&arrays)?;
+        // Angles wrapped as `insert` wraps them (its inserts, bit for bit).
+        let poses: Vec<Pose2> = crate::convert::poses(poses, "poses")?
+            .into_iter()
+            .map(|[x, y, theta]| Pose2::new(x, y, theta))
+            .collect();
+        py.detach(|| {
+            let mut grid = self.inner.write().map_err(|_| poisoned())?;
+            grid.insert_many(&pairs, &poses).map_err(to_py)
+        })
+    }
+
     /// Matches scan-frame points against the map from `guess`.
     #[pyo3(name = "match", signature = (
         points, guess, *, expansion = 10.0, sigma_floor = 0.02, shape_cell = 0.32, neighbor_search = true, fuse_minority = true,
@@ -220,11 +243,8 @@ impl PyNdtGrid {
         let threads = threads
             .map(|t| count("threads", t).map(|t| t as usize))
             .transpose()?;
-        let arrays = point_sets(scans, "scans")?;
-        let pairs = arrays
-            .iter()
-            .map(|a| a.as_pairs())
-            .collect::<PyResult<Vec<_>>>()?;
+        let arrays = point_sets(scans, "scans", "match")?;
+        let pairs = Points::all_pairs(&arrays)?;
         let guesses: Vec<Pose2> = poses(guesses, "guesses")?
             .into_iter()
             .map(|[x, y, theta]| Pose2 { x, y, theta })

@@ -79,58 +79,11 @@ impl DerefMut for Deferral<'_> {
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
-    use crate::distributions::DistOptions;
     use crate::key::CellKey;
     use crate::se2::Pose2;
+    use crate::testing::assert_same_grids as assert_same;
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
-
-    const OPTIONS: [DistOptions; 2] = [
-        // Shaped fine levels (the match's default) and every level on its own
-        // (the odometry loop's).
-        DistOptions {
-            expansion: 10.0,
-            fuse_minority: true,
-            sigma_floor: 0.02,
-            shape_cell: 0.32,
-        },
-        DistOptions {
-            expansion: 30.0,
-            fuse_minority: true,
-            sigma_floor: 0.01,
-            shape_cell: 0.0,
-        },
-    ];
-
-    /// Every level's sums and every prepared distribution of `a` and `b`
-    /// are equal, bit for bit.
-    fn assert_same(a: &NdtGrid, b: &NdtGrid) {
-        for l in 0..a.levels() {
-            let cells = |g: &NdtGrid| {
-                let mut v: Vec<_> = g
-                    .level(l)
-                    .unwrap()
-                    .cells()
-                    .iter()
-                    .map(|(k, c)| (k, *c))
-                    .collect();
-                v.sort_unstable_by_key(|(k, _)| *k);
-                v
-            };
-            let (ca, cb) = (cells(a), cells(b));
-            assert_eq!(ca, cb, "level {l}");
-            for options in OPTIONS {
-                let (da, db) = (
-                    a.distributions(l, options).unwrap(),
-                    b.distributions(l, options).unwrap(),
-                );
-                assert_eq!(da.len(), db.len(), "level {l}");
-                for (k, _) in &ca {
-                    assert_eq!(da.get(*k), db.get(*k), "level {l} cell {k:?}");
-                }
-            }
-        }
-    }
 
     /// Inserts and removals inside (nested) deferrals leave the grid as the
     /// same calls one by one do: the coarser levels, the prepared
@@ -142,7 +95,7 @@ mod tests {
         let mut eager = NdtGrid::new(0.02).unwrap();
         eager.insert(&[[0.0, 0.0]], Pose2::identity()).unwrap();
         for l in 0..eager.levels() {
-            for options in OPTIONS {
+            for options in crate::testing::GRID_OPTIONS {
                 let _ = eager.distributions(l, options);
             }
         }
