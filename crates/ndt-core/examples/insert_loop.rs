@@ -5,7 +5,9 @@
 //! takes 8 simulated scans of the tests' room, then `n` times one of 64
 //! scans from a ring of poses is matched with the default options (so the
 //! distributions are built, as in a SLAM loop) and inserted; prints the
-//! mean time of an insert and of a match.
+//! mean time of an insert and of a match. `insert_loop [beams] [n] [batch]`
+//! with `batch > 1`: `n` rounds of `batch` consecutive ring scans, the
+//! first matched, all inserted by one `insert_many` call (time per scan).
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -26,6 +28,7 @@ fn arg(i: usize, default: usize) -> Result<usize, Box<dyn Error>> {
 fn main() -> Result<(), Box<dyn Error>> {
     let beams = arg(1, 683)?;
     let rounds = arg(2, 300)?;
+    let batch = arg(3, 1)?;
     let mut grid = NdtGrid::new(0.02)?;
     for i in 0..8u32 {
         let a = f64::from(i) * 0.8;
@@ -41,6 +44,31 @@ fn main() -> Result<(), Box<dyn Error>> {
         .collect();
     let options = MatchOptions::default();
     let (mut t_insert, mut t_match) = (0.0, 0.0);
+    if batch > 1 {
+        // Rounds of `batch` consecutive ring scans: the first matched, all
+        // inserted by one insert_many call.
+        for k in 0..rounds {
+            let (scans, poses): (Vec<&[[f64; 2]]>, Vec<Pose2>) = (0..batch)
+                .map(|j| {
+                    let (pose, points) = &ring[(k * batch + j) % ring.len()];
+                    (points.as_slice(), *pose)
+                })
+                .unzip();
+            let t = Instant::now();
+            grid.match_scan(scans[0], poses[0], &options)?;
+            t_match += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            grid.insert_many(&scans, &poses)?;
+            t_insert += t.elapsed().as_secs_f64();
+        }
+        let per = 1e6 / rounds.max(1) as f64;
+        println!(
+            "{rounds} rounds of {batch} scans of {beams} beams: insert_many {:.1} us a scan, match {:.1} us",
+            t_insert * per / batch as f64,
+            t_match * per
+        );
+        return Ok(());
+    }
     for k in 0..rounds {
         let (pose, points) = &ring[k % ring.len()];
         let t = Instant::now();

@@ -274,6 +274,31 @@ impl NdtGrid {
         })
     }
 
+    /// The checks of [`NdtGrid::stage`] alone, with the same errors, for a
+    /// batch checked before any scan of it is staged; `spare` is handed back
+    /// (or used, see below). A rotation keeps each point's distance from the
+    /// scan's origin, so no point of the scan ends beyond the lattice when
+    /// its farthest point's distance and the pose's translation add up to at
+    /// most half of [`NdtGrid::coordinate_limit`] (a margin far above any
+    /// rounding of eq. 2); a scan that does not pass this bound is staged.
+    pub(crate) fn check_staging(
+        &self,
+        points: &[[f64; 2]],
+        pose: Pose2,
+        spare: StagedScan,
+    ) -> Result<StagedScan> {
+        check_finite("pose", &pose.to_array())?;
+        check_points("points", points)?;
+        let farthest = points
+            .iter()
+            .fold(0.0f64, |m, p| m.max(p[0] * p[0] + p[1] * p[1]))
+            .sqrt();
+        if farthest + pose.x.hypot(pose.y) <= 0.5 * self.coordinate_limit() {
+            return Ok(spare);
+        }
+        self.stage(points, pose, spare)
+    }
+
     /// Adds a scan staged by [`NdtGrid::stage`] on this grid: eq. (6) into
     /// every pyramid level, then the prepared distributions of the touched
     /// cells. Returns the touched finest-level keys (see [`NdtGrid::insert`]).

@@ -29,8 +29,10 @@ impl NdtGrid {
     /// it before the grid changes ([`crate::NdtError::InScan`] names the first scan
     /// rejected), and a number of poses other than one per scan is an error
     /// ([`crate::NdtError::PoseCount`]). Memory beyond the grid's is one scan's
-    /// staged points: each scan is staged (eq. 2) once to be checked and
-    /// again to be inserted. An empty batch changes nothing.
+    /// staged points: the check stages a scan (eq. 2) only when a bound on
+    /// its reach does not already keep it within the lattice
+    /// ([`NdtGrid::check_staging`]), and the insert stages it again. An
+    /// empty batch changes nothing.
     pub fn insert_many(&mut self, scans: &[&[[f64; 2]]], poses: &[Pose2]) -> Result<()> {
         check_pose_count("poses", scans.len(), poses.len())?;
         if let ([points], [pose]) = (scans, poses) {
@@ -41,7 +43,9 @@ impl NdtGrid {
         }
         let mut spare = StagedScan::default();
         for (index, (points, pose)) in scans.iter().zip(poses).enumerate() {
-            spare = self.stage(points, *pose, spare).map_err(in_scan(index))?;
+            spare = self
+                .check_staging(points, *pose, spare)
+                .map_err(in_scan(index))?;
         }
         let mut grid = self.deferral();
         for (points, pose) in scans.iter().zip(poses) {
@@ -119,6 +123,47 @@ mod tests {
             batched.insert_many(&views, &poses).unwrap();
             assert!(batched.pending.is_empty(), "round {round}");
             assert_same(&one_by_one, &batched);
+        }
+    }
+
+    /// Far from the origin, where the quick bound on a scan's reach does not
+    /// hold, a batch accepts and rejects what the inserts do, with their errors.
+    #[test]
+    fn far_scans_are_checked_as_insert_checks_them() {
+        let limit = NdtGrid::new(0.02).unwrap().coordinate_limit();
+        let cases = [
+            // (point, pose): within the bound, beyond it but inside the
+            // lattice, beyond the lattice by the point or by the pose.
+            ([0.2 * limit, 0.0], Pose2::new(0.2 * limit, 0.0, 0.0)),
+            ([0.6 * limit, 0.0], Pose2::new(0.0, 0.3 * limit, 2.0)),
+            ([0.0, 0.45 * limit], Pose2::new(0.5 * limit, 0.0, 0.0)),
+            ([0.6 * limit, 0.0], Pose2::new(0.6 * limit, 0.0, 0.0)),
+            ([0.0, 1.2 * limit], Pose2::identity()),
+            ([1.0, 0.0], Pose2::new(-1.1 * limit, 0.0, 0.3)),
+        ];
+        for (i, (point, pose)) in cases.into_iter().enumerate() {
+            let mut batched = prepared_grid();
+            let scans = [[[0.0, 0.0], point]];
+            let single = prepared_grid().insert(&scans[0], pose).map(|_| ());
+            let views: Vec<&[[f64; 2]]> = vec![&[[0.1, 0.1]], &scans[0]];
+            let poses = [Pose2::identity(), pose];
+            match single {
+                Ok(()) => {
+                    // The same inserts, in the batch's order.
+                    let mut ordered = prepared_grid();
+                    ordered.insert(&[[0.1, 0.1]], Pose2::identity()).unwrap();
+                    ordered.insert(&scans[0], pose).unwrap();
+                    batched.insert_many(&views, &poses).unwrap();
+                    assert_same(&ordered, &batched);
+                    assert!(i < 3, "case {i} was expected to fail");
+                }
+                Err(e) => {
+                    let got = batched.insert_many(&views, &poses).unwrap_err();
+                    assert_eq!(got.to_string(), format!("scan 1: {e}"), "case {i}");
+                    assert_eq!(batched.cell_states(), prepared_grid().cell_states());
+                    assert!(i >= 3, "case {i} was expected to pass");
+                }
+            }
         }
     }
 
