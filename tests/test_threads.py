@@ -1,9 +1,9 @@
 """Threads (issue 6): many matchers while one thread inserts; Mapper and Odometry shared.
 
 The contract (README, ``_core.pyi``): a map is many readers / one exclusive writer. ``match``,
-``evaluate``, ``cells`` ... take a read lock and ``insert`` / ``insert_scan`` a write lock, all
-with the GIL released, so a match sees the map as it was between two inserts, never half an
-insert.
+``evaluate``, ``cells`` ... take a read lock and ``insert`` / ``insert_many`` / ``insert_scan`` a
+write lock, all with the GIL released, so a match sees the map as it was between two inserts
+(or batches), never half an insert.
 
 **The reference.** The writer inserts scans ``S_1 .. S_n`` in order; before the threads start,
 the same sequence is replayed on a fresh map and every query is matched after each insert:
@@ -179,6 +179,56 @@ def test_matches_while_one_thread_inserts_see_whole_states_in_order(
         # The last round started after the last insert: it sees the final state.
         assert state == len(SCANS)
     assert len(reached) >= len(SCANS) // 2
+
+
+def test_matches_while_one_thread_inserts_batches_never_see_half_a_batch() -> None:
+    """``insert_many`` holds the write lock for its whole batch: a match sees the map before
+    or after a batch, never between two of its scans. Its map is the inserts' one by one,
+    bit for bit, so the states between batches are ``ref[1]``, ``ref[4]``, ``ref[7]`` and
+    ``ref[10]``, and no result may equal a state inside a batch."""
+    ref = states_of(insert_grid, lambda: ndtgrid.NdtGrid(0.02))
+    grid = ndtgrid.NdtGrid(0.02)
+    insert_grid(grid, 0)
+    batches = {1: range(1, 4), 4: range(4, 7), 7: range(7, 10)}
+    whole = [1, 4, 7, 10]
+    done = threading.Event()
+    seen: list[list[tuple[int, tuple[Any, ...]]]] = [[] for _ in range(N_READERS)]
+    errors: list[BaseException] = []
+
+    def reader(i: int) -> None:
+        try:
+            q = i
+            while True:
+                last_round = done.is_set()
+                seen[i].append((q % len(QUERIES), run_match(grid, q % len(QUERIES))))
+                q += 1
+                if last_round:
+                    break
+        except BaseException as e:  # pragma: no cover - reported below
+            errors.append(e)
+
+    def write(k: int) -> None:
+        if k in batches:
+            grid.insert_many(
+                [SCANS[j][0] for j in batches[k]], np.array([SCANS[j][1] for j in batches[k]])
+            )
+
+    threads = [threading.Thread(target=reader, args=(i,), daemon=True) for i in range(N_READERS)]
+    insert_while_reading(threads, seen, write, done, errors)
+    reached = set()
+    for i in range(N_READERS):
+        assert seen[i], f"reader {i} got no result"
+        state = 1
+        for q, result in seen[i]:
+            candidates = [k for k in range(1, len(SCANS) + 1) if ref[k][q] == result]
+            assert candidates, f"reader {i}: a result equal to no state (torn read)"
+            assert set(candidates) <= set(whole), f"reader {i}: inside a batch: {candidates}"
+            later = [k for k in candidates if k >= state]
+            assert later, f"reader {i}: state went back from {state} to {candidates}"
+            state = later[0]
+            reached.add(state)
+        assert state == len(SCANS)
+    assert len(reached) >= 3
 
 
 def test_match_many_while_one_thread_inserts_sees_one_state_per_batch() -> None:
