@@ -118,6 +118,54 @@ def run_writers_then_stop_readers(
     assert not any(t.is_alive() for t in writers + readers), "deadlock"
 
 
+def query_readers(
+    grid: ndtgrid.NdtGrid,
+    seen: list[list[tuple[int, tuple[Any, ...]]]],
+    done: threading.Event,
+    errors: list[BaseException],
+) -> list[threading.Thread]:
+    """One thread per list of ``seen``: each matches the queries in turn (reader ``i``
+    from query ``i``), appending ``(query, result)``, until a round that began after
+    ``done`` was set; exceptions go to ``errors``."""
+
+    def reader(i: int) -> None:
+        try:
+            q = i
+            while True:
+                last_round = done.is_set()
+                seen[i].append((q % len(QUERIES), run_match(grid, q % len(QUERIES))))
+                q += 1
+                if last_round:
+                    break
+        except BaseException as e:  # pragma: no cover - reported by the caller
+            errors.append(e)
+
+    return [threading.Thread(target=reader, args=(i,), daemon=True) for i in range(len(seen))]
+
+
+def states_reached(
+    seen: list[list[tuple[int, tuple[Any, ...]]]], ref: list[list[Any]], allowed: Any
+) -> set[int]:
+    """Checks each reader's results against the states ``ref`` (a result must equal some
+    state's, bit for bit, among ``allowed``; a reader's states can only go forward, and its
+    last round, begun after the last insert, sees the final state); returns the states
+    reached."""
+    reached = set()
+    for i, results in enumerate(seen):
+        assert results, f"reader {i} got no result"
+        state = 1
+        for q, result in results:
+            candidates = [k for k in range(1, len(SCANS) + 1) if ref[k][q] == result]
+            assert candidates, f"reader {i}: a result equal to no state (torn read)"
+            assert set(candidates) <= set(allowed), f"reader {i}: between states: {candidates}"
+            later = [k for k in candidates if k >= state]
+            assert later, f"reader {i}: state went back from {state} to {candidates}"
+            state = later[0]
+            reached.add(state)
+        assert state == len(SCANS)
+    return reached
+
+
 def insert_grid(g: ndtgrid.NdtGrid, k: int) -> None:
     g.insert(*SCANS[k])
 
@@ -149,35 +197,10 @@ def test_matches_while_one_thread_inserts_see_whole_states_in_order(
     done = threading.Event()
     seen: list[list[tuple[int, tuple[Any, ...]]]] = [[] for _ in range(N_READERS)]
     errors: list[BaseException] = []
-
-    def reader(i: int) -> None:
-        try:
-            q = i
-            while True:
-                last_round = done.is_set()
-                seen[i].append((q % len(QUERIES), run_match(grid, q % len(QUERIES))))
-                q += 1
-                if last_round:
-                    break
-        except BaseException as e:  # pragma: no cover - reported below
-            errors.append(e)
-
-    threads = [threading.Thread(target=reader, args=(i,), daemon=True) for i in range(N_READERS)]
+    threads = query_readers(grid, seen, done, errors)
     insert_while_reading(threads, seen, lambda k: insert(target, k), done, errors)
 
-    reached = set()
-    for i in range(N_READERS):
-        assert seen[i], f"reader {i} got no result"
-        state = 1
-        for q, result in seen[i]:
-            candidates = [k for k in range(1, len(SCANS) + 1) if ref[k][q] == result]
-            assert candidates, f"reader {i}: a result equal to no state (torn read)"
-            later = [k for k in candidates if k >= state]
-            assert later, f"reader {i}: state went back from {state} to {candidates}"
-            state = later[0]
-            reached.add(state)
-        # The last round started after the last insert: it sees the final state.
-        assert state == len(SCANS)
+    reached = states_reached(seen, ref, range(1, len(SCANS) + 1))
     assert len(reached) >= len(SCANS) // 2
 
 
@@ -195,40 +218,15 @@ def test_matches_while_one_thread_inserts_batches_never_see_half_a_batch() -> No
     seen: list[list[tuple[int, tuple[Any, ...]]]] = [[] for _ in range(N_READERS)]
     errors: list[BaseException] = []
 
-    def reader(i: int) -> None:
-        try:
-            q = i
-            while True:
-                last_round = done.is_set()
-                seen[i].append((q % len(QUERIES), run_match(grid, q % len(QUERIES))))
-                q += 1
-                if last_round:
-                    break
-        except BaseException as e:  # pragma: no cover - reported below
-            errors.append(e)
-
     def write(k: int) -> None:
         if k in batches:
             grid.insert_many(
                 [SCANS[j][0] for j in batches[k]], np.array([SCANS[j][1] for j in batches[k]])
             )
 
-    threads = [threading.Thread(target=reader, args=(i,), daemon=True) for i in range(N_READERS)]
+    threads = query_readers(grid, seen, done, errors)
     insert_while_reading(threads, seen, write, done, errors)
-    reached = set()
-    for i in range(N_READERS):
-        assert seen[i], f"reader {i} got no result"
-        state = 1
-        for q, result in seen[i]:
-            candidates = [k for k in range(1, len(SCANS) + 1) if ref[k][q] == result]
-            assert candidates, f"reader {i}: a result equal to no state (torn read)"
-            assert set(candidates) <= set(whole), f"reader {i}: inside a batch: {candidates}"
-            later = [k for k in candidates if k >= state]
-            assert later, f"reader {i}: state went back from {state} to {candidates}"
-            state = later[0]
-            reached.add(state)
-        assert state == len(SCANS)
-    assert len(reached) >= 3
+    assert len(states_reached(seen, ref, whole)) >= 3
 
 
 def test_match_many_while_one_thread_inserts_sees_one_state_per_batch() -> None:

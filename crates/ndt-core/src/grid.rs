@@ -239,8 +239,7 @@ impl NdtGrid {
         pose: Pose2,
         spare: StagedScan,
     ) -> Result<StagedScan> {
-        check_finite("pose", &pose.to_array())?;
-        check_points("points", points)?;
+        check_values(points, pose)?;
         let sin_cos = pose.theta.sin_cos();
         let inv = self.inv_cell_size;
         // One pass without an exit per point (eq. 2, then the cell): whether
@@ -274,29 +273,20 @@ impl NdtGrid {
         })
     }
 
-    /// The checks of [`NdtGrid::stage`] alone, with the same errors, for a
-    /// batch checked before any scan of it is staged; `spare` is handed back
-    /// (or used, see below). A rotation keeps each point's distance from the
-    /// scan's origin, so no point of the scan ends beyond the lattice when
-    /// its farthest point's distance and the pose's translation add up to at
-    /// most half of [`NdtGrid::coordinate_limit`] (a margin far above any
-    /// rounding of eq. 2); a scan that does not pass this bound is staged.
-    pub(crate) fn check_staging(
-        &self,
-        points: &[[f64; 2]],
-        pose: Pose2,
-        spare: StagedScan,
-    ) -> Result<StagedScan> {
-        check_finite("pose", &pose.to_array())?;
-        check_points("points", points)?;
+    /// The value checks of [`NdtGrid::stage`] (the same errors), and whether
+    /// the scan surely lies within the lattice without staging it: a
+    /// rotation keeps each point's distance from the scan's origin, so no
+    /// point ends beyond the lattice when the farthest point's distance and
+    /// the pose's translation add up to at most half of
+    /// [`NdtGrid::coordinate_limit`] (a margin far above any rounding of
+    /// eq. 2). `false`: only [`NdtGrid::stage`] can tell.
+    pub(crate) fn check_reach(&self, points: &[[f64; 2]], pose: Pose2) -> Result<bool> {
+        check_values(points, pose)?;
         let farthest = points
             .iter()
             .fold(0.0f64, |m, p| m.max(p[0] * p[0] + p[1] * p[1]))
             .sqrt();
-        if farthest + pose.x.hypot(pose.y) <= 0.5 * self.coordinate_limit() {
-            return Ok(spare);
-        }
-        self.stage(points, pose, spare)
+        Ok(farthest + pose.x.hypot(pose.y) <= 0.5 * self.coordinate_limit())
     }
 
     /// Adds a scan staged by [`NdtGrid::stage`] on this grid: eq. (6) into
@@ -463,6 +453,13 @@ fn shape_at(pyramid: &Pyramid, level: usize, depth: usize) -> Option<Shape<'_>> 
         return None;
     }
     pyramid.levels(level..=level + depth).and_then(Shape::new)
+}
+
+/// Rejects a non-finite pose, then non-finite points (a scan's values, as
+/// [`NdtGrid::insert`] checks them).
+fn check_values(points: &[[f64; 2]], pose: Pose2) -> Result<()> {
+    check_finite("pose", &pose.to_array())?;
+    check_points("points", points)
 }
 
 /// Rejects non-finite points.

@@ -31,7 +31,7 @@ impl NdtGrid {
     /// ([`crate::NdtError::PoseCount`]). Memory beyond the grid's is one scan's
     /// staged points: the check stages a scan (eq. 2) only when a bound on
     /// its reach does not already keep it within the lattice
-    /// ([`NdtGrid::check_staging`]), and the insert stages it again. An
+    /// ([`NdtGrid::check_reach`]), and the insert stages it again. An
     /// empty batch changes nothing.
     pub fn insert_many(&mut self, scans: &[&[[f64; 2]]], poses: &[Pose2]) -> Result<()> {
         check_pose_count("poses", scans.len(), poses.len())?;
@@ -43,9 +43,9 @@ impl NdtGrid {
         }
         let mut spare = StagedScan::default();
         for (index, (points, pose)) in scans.iter().zip(poses).enumerate() {
-            spare = self
-                .check_staging(points, *pose, spare)
-                .map_err(in_scan(index))?;
+            if !self.check_reach(points, *pose).map_err(in_scan(index))? {
+                spare = self.stage(points, *pose, spare).map_err(in_scan(index))?;
+            }
         }
         let mut grid = self.deferral();
         for (points, pose) in scans.iter().zip(poses) {
