@@ -13,6 +13,9 @@
 //!   cells, and a match on the grid (whose distributions were prepared
 //!   incrementally in between) equals the match on that rebuilt grid, bit
 //!   for bit; a failed call changes nothing.
+//! - `insert_many`: arbitrary batches; the grid the inserts one by one give,
+//!   or, when an insert would reject a scan, that scan's error (the first
+//!   such) and no change at all; either way consistent with a rebuild.
 //! - `remove_cells`: arbitrary keys (present, absent, repeated) remove exactly
 //!   the distinct present ones and leave a grid equal to a rebuild.
 //! - `Odometry::step`: random scans, odometry and invalid readings; a failed
@@ -255,6 +258,44 @@ proptest! {
             prop_assert!(close(r.scatter[(1, 1)], q[2], scale));
         }
         assert_consistent(&grid, &[[1.0, 0.5], [-1.0, 0.2], [0.3, 1.9]], Pose2::identity())?;
+    }
+
+    #[test]
+    fn insert_many_equals_the_inserts_or_changes_nothing(
+        batch in prop::collection::vec((points(60), pose()), 0..6),
+    ) {
+        // The first scan an insert rejects, with its error, on a scratch grid.
+        let mut scratch = room_grid();
+        let first_error = batch
+            .iter()
+            .enumerate()
+            .find_map(|(i, (pts, p))| scratch.insert(pts, *p).err().map(|e| (i, e)));
+        let mut one_by_one = room_grid();
+        let mut batched = room_grid();
+        // Distributions prepared before the batch, kept up to date by it.
+        let probe = [[1.0, 0.5], [-1.0, 0.2], [0.3, 1.9]];
+        let _ = batched.match_scan(&probe, Pose2::identity(), &MatchOptions::default());
+        let before = batched.cell_states();
+        let views: Vec<&[[f64; 2]]> = batch.iter().map(|(pts, _)| pts.as_slice()).collect();
+        let poses: Vec<Pose2> = batch.iter().map(|(_, p)| *p).collect();
+        match (batched.insert_many(&views, &poses), first_error) {
+            (Ok(()), None) => {
+                for (pts, p) in &batch {
+                    one_by_one.insert(pts, *p).unwrap_or_else(|e| panic!("{e}"));
+                }
+                prop_assert_eq!(one_by_one.cell_states(), batched.cell_states());
+                prop_assert_eq!(one_by_one.key_bounds(), batched.key_bounds());
+            }
+            (Err(NdtError::InScan { index, error }), Some((i, e))) => {
+                prop_assert_eq!(index, i);
+                prop_assert_eq!(error.to_string(), e.to_string());
+                prop_assert_eq!(&before, &batched.cell_states());
+            }
+            (got, want) => {
+                return Err(TestCaseError::fail(format!("batch {got:?}, inserts {want:?}")));
+            }
+        }
+        assert_consistent(&batched, &probe, Pose2::identity())?;
     }
 
     // The option strategies are boxed: fourteen unboxed value trees overflow
