@@ -182,7 +182,10 @@ class NdtGrid:
         shared: building a map from a log whose poses are known (ground truth,
         a finished SLAM run, an optimised trajectory) takes less time per scan
         the longer the batch (BENCHMARK.md, "Speed", session 37). The GIL is
-        released once for the whole batch; matches wait for it to finish.
+        released once for the whole batch; matches wait for it to finish. The
+        keys of the cells each scan changed (8 bytes a cell and scan) wait for
+        the batch's end, so a very long log is best given in batches of some
+        hundreds of scans.
 
         Parameters
         ----------

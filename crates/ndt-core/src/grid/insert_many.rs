@@ -28,11 +28,12 @@ impl NdtGrid {
     /// All-or-nothing: every scan is checked as [`NdtGrid::insert`] checks
     /// it before the grid changes ([`crate::NdtError::InScan`] names the first scan
     /// rejected), and a number of poses other than one per scan is an error
-    /// ([`crate::NdtError::PoseCount`]). Memory beyond the grid's is one scan's
-    /// staged points: the check stages a scan (eq. 2) only when a bound on
-    /// its reach does not already keep it within the lattice
-    /// ([`NdtGrid::check_reach`]), and the insert stages it again. An
-    /// empty batch changes nothing.
+    /// ([`crate::NdtError::PoseCount`]). The check stages a scan (eq. 2) only
+    /// when a bound on its reach does not already keep it within the lattice
+    /// ([`NdtGrid::check_reach`]), and the insert stages it again. Memory
+    /// beyond the grid's: one scan's staged points, and the keys of the fine
+    /// cells each scan changed (8 bytes a cell and scan), which wait for the
+    /// batch's end. An empty batch changes nothing.
     pub fn insert_many(&mut self, scans: &[&[[f64; 2]]], poses: &[Pose2]) -> Result<()> {
         check_pose_count("poses", scans.len(), poses.len())?;
         if let ([points], [pose]) = (scans, poses) {
