@@ -30,7 +30,7 @@ impl NdtGrid {
     /// rejected), and a number of poses other than one per scan is an error
     /// ([`crate::NdtError::PoseCount`]). The check stages a scan (eq. 2) only
     /// when a bound on its reach does not already keep it within the lattice
-    /// ([`NdtGrid::check_reach`]), and the insert stages it again. Memory
+    /// (see `check_reach`), and the insert stages it again. Memory
     /// beyond the grid's: one scan's staged points, and the keys of the fine
     /// cells each scan changed (8 bytes a cell and scan), which wait for the
     /// batch's end. An empty batch changes nothing.
