@@ -60,6 +60,19 @@ impl PyNdtGrid {
         })
         .map_err(|()| poisoned())
     }
+
+    /// `f` on the grid under its write lock, with the GIL released (the
+    /// inserts: matches wait for them, see `read`).
+    fn write<T>(&self, py: Python<'_>, f: impl FnOnce(&mut NdtGrid) -> T + Send) -> PyResult<T>
+    where
+        T: Send,
+    {
+        py.detach(|| {
+            let mut grid = self.inner.write().map_err(|_| ())?;
+            Ok(f(&mut grid))
+        })
+        .map_err(|()| poisoned())
+    }
 }
 
 #[pymethods]
@@ -113,12 +126,11 @@ impl PyNdtGrid {
         let pts = points_arg(points)?;
         let pairs = pts.as_pairs()?;
         let p = crate::convert::pose(pose, "pose")?;
-        py.detach(|| {
-            let mut grid = self.inner.write().map_err(|_| poisoned())?;
-            grid.insert(pairs, Pose2::new(p[0], p[1], p[2]))
-                .map(|_| ())
-                .map_err(to_py)
-        })
+        // The changed keys are dropped inside, without the GIL.
+        self.write(py, |grid| {
+            grid.insert(pairs, Pose2::new(p[0], p[1], p[2])).map(|_| ())
+        })?
+        .map_err(to_py)
     }
 
     /// eq. (6) for many scans in one call: the coarser levels and prepared
@@ -136,10 +148,8 @@ impl PyNdtGrid {
             .into_iter()
             .map(|[x, y, theta]| Pose2::new(x, y, theta))
             .collect();
-        py.detach(|| {
-            let mut grid = self.inner.write().map_err(|_| poisoned())?;
-            grid.insert_many(&pairs, &poses).map_err(to_py)
-        })
+        self.write(py, |grid| grid.insert_many(&pairs, &poses))?
+            .map_err(to_py)
     }
 
     /// Matches scan-frame points against the map from `guess`.
