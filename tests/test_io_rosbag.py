@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import math
 from pathlib import Path
 from typing import Any
@@ -75,8 +76,16 @@ def messages(with_odom: bool = True) -> list[tuple[str, str, float, Any]]:
     return sorted(out, key=lambda m: m[2])
 
 
+def ros2_writer(path: Path) -> Any:
+    """A ROS 2 bag writer: rosbags 0.10 on asks which bag version to write (9, the
+    newest), 0.9 (the last for Python 3.9) writes its own."""
+    if "version" in inspect.signature(Writer2).parameters:
+        return Writer2(path, version=9)
+    return Writer2(path)  # type: ignore[call-arg]  # rosbags 0.9
+
+
 def write_bag(path: Path, version: int, msgs: list[tuple[str, str, float, Any]]) -> Path:
-    writer = Writer1(path) if version == 1 else Writer2(path, version=9)
+    writer = Writer1(path) if version == 1 else ros2_writer(path)
     with writer:
         conns: dict[str, Any] = {}
         for topic, msgtype, t, msg in msgs:

@@ -4,18 +4,44 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Sequence
-from typing import Any, TypedDict, Unpack
+from typing import Any, TypedDict, final
 
 import numpy as np
 import numpy.typing as npt
+from typing_extensions import Self, Unpack
 
 __version__: str
 #: The version of the ndtgrid file format this build writes (and the only one it reads).
 FORMAT_VERSION: int
 
-ArrayLike = npt.ArrayLike
-F64Array = npt.NDArray[np.float64]
-I64Array = npt.NDArray[np.int64]
+_ArrayLike = npt.ArrayLike
+_F64Array = npt.NDArray[np.float64]
+_I64Array = npt.NDArray[np.int64]
+# Scans given together: a list of (N_i, 2) arrays, or one (K, N, 2) array.
+_Scans = Sequence[_ArrayLike] | npt.NDArray[Any]
+
+__all__ = [
+    "FORMAT_VERSION",
+    "FreeSpace",
+    "Mapper",
+    "MapperOptions",
+    "MatchResult",
+    "NdtGrid",
+    "OdometryLoop",
+    "OdometryStep",
+    "RemovalCounts",
+    "SmallObject",
+    "__version__",
+    "between",
+    "compose",
+    "default_mapper_options",
+    "default_match_options",
+    "default_odometry_config",
+    "inverse",
+    "preset_match_options",
+    "ranges_to_points",
+    "vector_extension",
+]
 
 class _MatchOptions(TypedDict, total=False):
     """The keyword options of :meth:`NdtGrid.match`, as :meth:`NdtGrid.match_many`
@@ -44,6 +70,7 @@ class _MatchOptions(TypedDict, total=False):
     expansion_phases: Sequence[float] | None
     parallel: bool
 
+@final
 class MatchResult:
     """Outcome of :meth:`NdtGrid.match`; frozen.
 
@@ -80,7 +107,7 @@ class MatchResult:
     """
 
     @property
-    def pose(self) -> F64Array: ...
+    def pose(self) -> _F64Array: ...
     @property
     def converged(self) -> bool: ...
     @property
@@ -90,14 +117,15 @@ class MatchResult:
     @property
     def num_matched(self) -> int: ...
     @property
-    def hessian(self) -> F64Array: ...
+    def hessian(self) -> _F64Array: ...
     @property
-    def covariance(self) -> F64Array: ...
+    def covariance(self) -> _F64Array: ...
     @property
-    def unconstrained(self) -> F64Array: ...
+    def unconstrained(self) -> _F64Array: ...
     @property
     def degenerate(self) -> bool: ...
 
+@final
 class NdtGrid:
     """Sparse, unbounded NDT grid map (paper §III-B).
 
@@ -134,7 +162,7 @@ class NdtGrid:
     or leaves the map unchanged.
     """
 
-    def __init__(self, cell_size: float = 0.02, *, levels: int = 6) -> None: ...
+    def __new__(cls, cell_size: float = 0.02, *, levels: int = 6) -> Self: ...
     @property
     def cell_size(self) -> float:
         """Cell size [m]."""
@@ -151,7 +179,7 @@ class NdtGrid:
         tables included. An estimate from the tables' capacities (hashbrown's
         layout; the allocator's own overhead is not counted):
         ``memory_bytes / len(grid)`` is the cost of an occupied cell."""
-    def insert(self, points: ArrayLike, pose: ArrayLike) -> None:
+    def insert(self, points: _ArrayLike, pose: _ArrayLike) -> None:
         """Add a scan to the map (eq. 6).
 
         Parameters
@@ -171,7 +199,7 @@ class NdtGrid:
             index would overflow (``|coordinate| >= 2**30 * cell_size``). The
             map is unchanged after any error.
         """
-    def insert_many(self, scans: Sequence[ArrayLike], poses: ArrayLike) -> None:
+    def insert_many(self, scans: _Scans, poses: _ArrayLike) -> None:
         """Add many scans to the map in one call (eq. 6 for each, in order).
 
         The map afterwards is, bit for bit, the one that :meth:`insert` gives
@@ -209,8 +237,8 @@ class NdtGrid:
         """
     def match(
         self,
-        points: ArrayLike,
-        guess: ArrayLike,
+        points: _ArrayLike,
+        guess: _ArrayLike,
         *,
         expansion: float = 10.0,
         sigma_floor: float = 0.02,
@@ -229,7 +257,7 @@ class NdtGrid:
         freeze_unconstrained: bool = True,
         freeze_ratio: float = 0.1,
         levels: int | None = None,
-        skip_levels: Sequence[int] | None = (1,),
+        skip_levels: Sequence[int] | None = None,
         coarse_model: bool = True,
         expansion_phases: Sequence[float] | None = None,
         parallel: bool = False,
@@ -336,12 +364,12 @@ class NdtGrid:
             pose and maximises the summed score of its level and the next
             coarser one (that one as its quadratic model, see
             ``coarse_model``), so the last stage includes the fine cells.
-        skip_levels : sequence of int, default (1,)
+        skip_levels : sequence of int or None, default None
             Pyramid levels (1 to 11) the stages pass over: a skipped level is
             neither matched on nor prepared, and the stage below it pairs with
             the next matched coarser level. The coarsest matched level is
-            matched whatever this says. Default: level 1 (4 cm on a 2 cm
-            grid; ``None`` means the same), ``()``: every level. Skipping 4 cm
+            matched whatever this says. ``None``: ``(1,)``, level 1 (4 cm on a
+            2 cm grid); ``()``: every level. Skipping 4 cm
             kept the successes of the benchmark's scan-to-scan pairs (6173 /
             6050 of 7680 real SICK starts against 6182 / 6052 on every level,
             held-out 6151 / 6064 against 6139 / 6060; from starts up to
@@ -386,8 +414,8 @@ class NdtGrid:
         """
     def match_many(
         self,
-        scans: Sequence[ArrayLike],
-        guesses: ArrayLike,
+        scans: _Scans,
+        guesses: _ArrayLike,
         *,
         threads: int | None = None,
         **options: Unpack[_MatchOptions],
@@ -450,8 +478,8 @@ class NdtGrid:
         """
     def evaluate(
         self,
-        points: ArrayLike,
-        pose: ArrayLike,
+        points: _ArrayLike,
+        pose: _ArrayLike,
         *,
         expansion: float = 10.0,
         sigma_floor: float = 0.02,
@@ -460,7 +488,7 @@ class NdtGrid:
         fuse_minority: bool = True,
         pair_neighbors: bool = False,
         search_radius: int = 1,
-    ) -> tuple[float, F64Array, F64Array, int]:
+    ) -> tuple[float, _F64Array, _F64Array, int]:
         """Score terms at ``pose`` without solving.
 
         Returns
@@ -474,7 +502,7 @@ class NdtGrid:
         num_matched : int
             Points with a reference distribution.
         """
-    def cells(self) -> tuple[F64Array, I64Array]:
+    def cells(self) -> tuple[_F64Array, _I64Array]:
         """Occupied cells, sorted by cell index.
 
         Returns
@@ -484,7 +512,7 @@ class NdtGrid:
         counts : ndarray, shape (K,)
             Point counts ``M``.
         """
-    def cell_states(self) -> tuple[I64Array, I64Array, F64Array, F64Array]:
+    def cell_states(self) -> tuple[_I64Array, _I64Array, _F64Array, _F64Array]:
         """The exact state of every cell, sorted by index (what a map file stores).
 
         Returns
@@ -502,10 +530,10 @@ class NdtGrid:
     @staticmethod
     def from_cell_states(
         cell_size: float,
-        indices: ArrayLike,
-        counts: ArrayLike,
-        sums: ArrayLike,
-        scatters: ArrayLike,
+        indices: _ArrayLike,
+        counts: _ArrayLike,
+        sums: _ArrayLike,
+        scatters: _ArrayLike,
     ) -> NdtGrid:
         """A grid holding exactly the given cell states (see :meth:`cell_states`).
 
@@ -516,7 +544,7 @@ class NdtGrid:
             below 1, a non-finite sum, an index beyond +-2**30 or an index given
             twice (the message names the cell's position).
         """
-    def cell_statistics(self) -> tuple[I64Array, I64Array, F64Array, F64Array]:
+    def cell_statistics(self) -> tuple[_I64Array, _I64Array, _F64Array, _F64Array]:
         """The eq. (6) sums of every cell in map coordinates, sorted by index.
 
         Returns
@@ -609,6 +637,7 @@ class NdtGrid:
         """
     def __reduce__(self) -> tuple[Callable[[bytes], NdtGrid], tuple[bytes]]: ...
 
+@final
 class MapperOptions:
     """Options of :class:`Mapper`: the elimination of false detections of §V; frozen.
 
@@ -693,8 +722,8 @@ class MapperOptions:
         For an unknown option.
     """
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         *,
         outlier_filter: bool = True,
         edge_removal: bool = True,
@@ -716,7 +745,7 @@ class MapperOptions:
         clear_margin: float = 0.03,
         clear_margin_relative: float = 0.015,
         pass_radius: float = 0.005,
-    ) -> None: ...
+    ) -> Self: ...
     @property
     def outlier_filter(self) -> bool: ...
     @property
@@ -762,6 +791,7 @@ class MapperOptions:
     def replace(self, **changes: Any) -> MapperOptions:
         """A copy with some options changed (like :func:`dataclasses.replace`)."""
 
+@final
 class SmallObject:
     """A small (sub-grid scale) object detected by :class:`Mapper`; frozen.
 
@@ -778,12 +808,13 @@ class SmallObject:
     """
 
     @property
-    def center(self) -> F64Array: ...
+    def center(self) -> _F64Array: ...
     @property
-    def cells(self) -> F64Array: ...
+    def cells(self) -> _F64Array: ...
     @property
     def num_points(self) -> int: ...
 
+@final
 class RemovalCounts:
     """What each §V step of a :class:`Mapper` removed so far; frozen.
 
@@ -830,6 +861,7 @@ class RemovalCounts:
     def as_dict(self) -> dict[str, int]:
         """Every counter by name, in step order (a-3, a-4, b-1, b-2, c, d)."""
 
+@final
 class Mapper:
     """An :class:`NdtGrid` fed scan by scan through the elimination of §V.
 
@@ -876,9 +908,9 @@ class Mapper:
     (2, True)
     """
 
-    def __init__(
-        self, cell_size: float = 0.02, *, outlier_filter: bool = True, **options: Any
-    ) -> None: ...
+    def __new__(
+        cls, cell_size: float = 0.02, *, outlier_filter: bool = True, **options: Any
+    ) -> Self: ...
     @property
     def grid(self) -> NdtGrid:
         """The map matched against: an :class:`NdtGrid` sharing this mapper's cells."""
@@ -893,7 +925,7 @@ class Mapper:
         """Scans inserted so far (a scan without a valid beam is not counted)."""
     def __len__(self) -> int:
         """Number of occupied cells."""
-    def insert_scan(self, ranges: ArrayLike, angles: ArrayLike, pose: ArrayLike) -> None:
+    def insert_scan(self, ranges: _ArrayLike, angles: _ArrayLike, pose: _ArrayLike) -> None:
         """Add one laser scan through the elimination of §V.
 
         Per scan: a-1 cluster the valid beams in beam order; a-2/a-3 in small
@@ -924,7 +956,7 @@ class Mapper:
             On a wrong shape, lengths that differ, a non-finite angle or pose, or
             a hit whose cell index would overflow. Nothing changes on error.
         """
-    def occupied_cells(self) -> F64Array:
+    def occupied_cells(self) -> _F64Array:
         """Centres of the cells the map keeps as occupied, shape (K, 2) [m], sorted by index."""
     def small_objects(self) -> list[SmallObject]:
         """The detected small objects, sorted by their smallest cell index."""
@@ -1014,13 +1046,13 @@ def preset_match_options(name: str) -> dict[str, Any]:
         For another name.
     """
 
-def compose(a: ArrayLike, b: ArrayLike) -> F64Array:
+def compose(a: _ArrayLike, b: _ArrayLike) -> _F64Array:
     """``a o b``: pose ``b`` (given in frame ``a``) in ``a``'s parent frame, shape (3,)."""
 
-def inverse(p: ArrayLike) -> F64Array:
+def inverse(p: _ArrayLike) -> _F64Array:
     """The inverse motion of ``p``, shape (3,)."""
 
-def between(a: ArrayLike, b: ArrayLike) -> F64Array:
+def between(a: _ArrayLike, b: _ArrayLike) -> _F64Array:
     """``a^-1 o b``: the motion from ``a`` to ``b`` in ``a``'s frame, shape (3,)."""
 
 def vector_extension() -> str | None:
@@ -1037,12 +1069,12 @@ def vector_extension() -> str | None:
     """
 
 def ranges_to_points(
-    ranges: ArrayLike,
-    angles: ArrayLike,
+    ranges: _ArrayLike,
+    angles: _ArrayLike,
     *,
     min_range: float = 0.0,
     max_range: float = ...,
-) -> F64Array:
+) -> _F64Array:
     """Scan-frame points of the valid beams of a laser scan.
 
     Parameters
@@ -1068,6 +1100,7 @@ def ranges_to_points(
         If the lengths differ, an angle is not finite or the limits are invalid.
     """
 
+@final
 class OdometryStep:
     """What one :meth:`OdometryLoop.step` did; frozen.
 
@@ -1095,9 +1128,9 @@ class OdometryStep:
     """
 
     @property
-    def pose(self) -> F64Array: ...
+    def pose(self) -> _F64Array: ...
     @property
-    def prediction(self) -> F64Array: ...
+    def prediction(self) -> _F64Array: ...
     @property
     def matched(self) -> bool: ...
     @property
@@ -1115,6 +1148,7 @@ class OdometryStep:
     @property
     def num_points(self) -> int: ...
 
+@final
 class OdometryLoop:
     """The core's scan-to-map odometry loop (wrapped by :class:`ndtgrid.Odometry`).
 
@@ -1133,8 +1167,8 @@ class OdometryLoop:
         If a setting is out of range (the message names it).
     """
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         cell_size: float = 0.02,
         *,
         min_range: float | None = None,
@@ -1177,9 +1211,9 @@ class OdometryLoop:
         match_filtered_map: bool | None = None,
         background_mapper: bool | None = None,
         build_map: bool | None = None,
-    ) -> None: ...
+    ) -> Self: ...
     def step(
-        self, ranges: ArrayLike, angles: ArrayLike, odom: ArrayLike | None = None
+        self, ranges: _ArrayLike, angles: _ArrayLike, odom: _ArrayLike | None = None
     ) -> OdometryStep:
         """Process one scan (ranges (B,) [m], angles (B,) [rad], odom (3,) or None).
 
@@ -1190,7 +1224,7 @@ class OdometryLoop:
             odom; the loop is unchanged after an error. The GIL is released.
         """
     @property
-    def poses(self) -> F64Array:
+    def poses(self) -> _F64Array:
         """Pose of every scan so far, shape (T, 3)."""
     @property
     def insertions(self) -> int:
@@ -1213,6 +1247,7 @@ class OdometryLoop:
 def default_odometry_config() -> dict[str, Any]:
     """The core's default :class:`OdometryLoop` settings (with ``cell_size``)."""
 
+@final
 class FreeSpace:
     """Cells crossed by laser beams, for occupancy exports (ROS maps, images).
 
@@ -1230,13 +1265,13 @@ class FreeSpace:
         If ``resolution`` is not a finite number > 0.
     """
 
-    def __init__(self, resolution: float = 0.05) -> None: ...
+    def __new__(cls, resolution: float = 0.05) -> Self: ...
     @property
     def resolution(self) -> float:
         """Cell size [m]."""
     def __len__(self) -> int:
         """Cells crossed by at least one beam."""
-    def add_scan(self, points: ArrayLike, pose: ArrayLike) -> None:
+    def add_scan(self, points: _ArrayLike, pose: _ArrayLike) -> None:
         """Trace the beams from the sensor at ``pose`` (3,) to the scan-frame ``points`` (N, 2) [m].
 
         Raises
@@ -1246,8 +1281,8 @@ class FreeSpace:
             lattice; nothing changes after an error.
         """
     def raster(
-        self, occupied: ArrayLike, *, max_cells: int = 100_000_000
-    ) -> tuple[npt.NDArray[np.int8], F64Array]:
+        self, occupied: _ArrayLike, *, max_cells: int = 100_000_000
+    ) -> tuple[npt.NDArray[np.int8], _F64Array]:
         """Dense occupancy image covering the traced cells and ``occupied`` (K, 2) points.
 
         Returns

@@ -166,7 +166,7 @@ impl PyNdtGrid {
         shape_cell=0.32, neighbor_search=True, fuse_minority=True, pair_neighbors=False, \
         search_radius=1, max_iterations=50, translation_tolerance=1e-4, rotation_tolerance=1e-4, \
         max_step_cells=2.0, max_step_rotation=0.05, rotation_search=0.15, rotation_gate=0.9, \
-        freeze_unconstrained=True, freeze_ratio=0.1, levels=None, skip_levels=(1,), \
+        freeze_unconstrained=True, freeze_ratio=0.1, levels=None, skip_levels=None, \
         coarse_model=True, expansion_phases=None, parallel=False)")]
     #[allow(clippy::too_many_arguments)]
     fn match_scan(
