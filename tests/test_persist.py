@@ -2,8 +2,10 @@
 
 ``NdtGrid`` / ``Mapper``: ``save``, ``load``, ``to_bytes``, ``from_bytes`` and pickle
 (also in another process) give back the map bit for bit, and a loaded mapper goes on
-exactly as the saved one. Errors have exact messages (``ValueError`` for a bad file,
-``OSError`` naming the file for I/O); writes are atomic; every truncation and seeded
+exactly as the saved one. The records the library returns (a match's result, an
+odometry step, small objects, removal counts, mapper options) pickle and copy by value.
+Errors have exact messages (``ValueError`` for a bad file, ``OSError`` naming the file
+for I/O); writes are atomic; every truncation and seeded
 byte flips are rejected. The large corruption runs are the Rust tests'
 (crates/ndt-core/tests/persist.rs); these are smaller runs through the binding.
 """
@@ -203,6 +205,64 @@ def test_pickles_go_through_a_multiprocessing_pool() -> None:
         theirs = pool.submit(_grow, mapper, 8, 12).result(timeout=120)
     feed(mapper, 8, 12)
     assert mapper_state(theirs) == mapper_state(mapper)
+
+
+def fields(record: Any) -> dict[str, Any]:
+    """Every public attribute of a record, arrays as their dtype, shape and bytes."""
+    out = {}
+    for name in dir(record):
+        value = getattr(record, name)
+        if name.startswith("_") or callable(value):
+            continue
+        if isinstance(value, np.ndarray):
+            value = (value.dtype.str, value.shape, value.tobytes())
+        out[name] = value
+    return out
+
+
+def records() -> list[Any]:
+    """One of each record the library returns: a match's result, an odometry step, a
+    small object, the §V removal counts and the mapper's options."""
+    mapper = ndtgrid.Mapper(0.02)
+    feed(mapper, 0, 40)
+    objects = mapper.small_objects()
+    assert objects, "the sticks room's walk finds small objects"
+    odometry = ndtgrid.Odometry()
+    poses, scans = walk()
+    for k in range(3):
+        odometry.step(scans[k][0], scans[k][1], poses[k])
+    grid = room_grid()
+    result = grid.match(room_scan([0.05, -0.02, 0.03], noise=0.005, seed=10), [0.03, 0, 0])
+    counts = mapper.removal_counts()
+    assert any(counts.as_dict().values())
+    return [result, odometry.last_step, objects[0], counts, mapper.options]
+
+
+def test_records_pickle_and_copy_by_value() -> None:
+    """Every protocol, ``copy`` and ``deepcopy`` give back every field bit for bit (a
+    record is immutable, so equal fields are an equal record)."""
+    for record in records():
+        want = fields(record)
+        assert len(want) >= 3, type(record).__name__
+        copies = [copy.copy(record), copy.deepcopy(record)]
+        copies += [pickle.loads(pickle.dumps(record, protocol=p)) for p in range(6)]
+        for back in copies:
+            assert type(back) is type(record)
+            assert fields(back) == want, type(record).__name__
+            assert repr(back) == repr(record)
+
+
+def _match_in_worker(grid: ndtgrid.NdtGrid, points: np.ndarray, guess: list[float]) -> Any:
+    return grid.match(points, guess)
+
+
+def test_match_results_come_back_from_a_process_pool() -> None:
+    """A match run in a worker process returns its result to the caller."""
+    grid = room_grid()
+    points = room_scan([0.05, -0.02, 0.03], noise=0.005, seed=10)
+    with ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn")) as pool:
+        theirs = pool.submit(_match_in_worker, grid, points, [0.03, 0.0, 0.0]).result(120)
+    assert fields(theirs) == fields(grid.match(points, [0.03, 0.0, 0.0]))
 
 
 # --- errors --------------------------------------------------------------------------------

@@ -124,6 +124,8 @@ class MatchResult:
     def unconstrained(self) -> _F64Array: ...
     @property
     def degenerate(self) -> bool: ...
+    def __reduce__(self) -> tuple[Callable[..., MatchResult], tuple[Any]]:
+        """Pickle (and :mod:`copy`) by value: the class's ``_restore`` and the fields."""
 
 @final
 class NdtGrid:
@@ -790,6 +792,8 @@ class MapperOptions:
         """Every option by name, in the order above."""
     def replace(self, **changes: Any) -> MapperOptions:
         """A copy with some options changed (like :func:`dataclasses.replace`)."""
+    def __reduce__(self) -> tuple[Callable[..., MapperOptions], tuple[Any]]:
+        """Pickle (and :mod:`copy`) by value: the class's ``_restore`` and the fields."""
 
 @final
 class SmallObject:
@@ -813,6 +817,8 @@ class SmallObject:
     def cells(self) -> _F64Array: ...
     @property
     def num_points(self) -> int: ...
+    def __reduce__(self) -> tuple[Callable[..., SmallObject], tuple[Any]]:
+        """Pickle (and :mod:`copy`) by value: the class's ``_restore`` and the fields."""
 
 @final
 class RemovalCounts:
@@ -860,6 +866,8 @@ class RemovalCounts:
     def confirmation_cells(self) -> int: ...
     def as_dict(self) -> dict[str, int]:
         """Every counter by name, in step order (a-3, a-4, b-1, b-2, c, d)."""
+    def __reduce__(self) -> tuple[Callable[..., RemovalCounts], tuple[Any]]:
+        """Pickle (and :mod:`copy`) by value: the class's ``_restore`` and the fields."""
 
 @final
 class Mapper:
@@ -1147,6 +1155,8 @@ class OdometryStep:
     def num_matched(self) -> int: ...
     @property
     def num_points(self) -> int: ...
+    def __reduce__(self) -> tuple[Callable[..., OdometryStep], tuple[Any]]:
+        """Pickle (and :mod:`copy`) by value: the class's ``_restore`` and the fields."""
 
 @final
 class OdometryLoop:

@@ -2,7 +2,7 @@
 
 use ndt_core::MapperOptions;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyType};
 
 use crate::convert::count;
 use crate::errors::to_py;
@@ -91,6 +91,23 @@ impl PyMapperOptions {
             }
         }
         py.get_type::<PyMapperOptions>().call((), Some(&all))
+    }
+
+    /// Pickle (and `copy`): `_restore` and `as_dict`.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyDict>,))> {
+        let options = options_dict(slf.py(), &slf.get().core())?;
+        Ok((slf.get_type().getattr("_restore")?, (options,)))
+    }
+
+    /// The options `__reduce__` took apart, checked as the constructor checks them.
+    #[classmethod]
+    fn _restore<'py>(
+        cls: &Bound<'py, PyType>,
+        options: &Bound<'py, PyDict>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        cls.call((), Some(options))
     }
 
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {

@@ -7,7 +7,7 @@ use std::sync::Mutex;
 use ndt_core::{MatchOptions, Odometry, OdometryConfig, Pose2, StepOutcome};
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyType};
 
 use crate::convert::{count, level_mask, level_tuple, pose, vec3, vector};
 use crate::errors::{poisoned, to_py};
@@ -21,6 +21,7 @@ pub struct PyOdometry {
 
 /// One step of the loop (see the stub for field docs).
 #[pyclass(name = "OdometryStep", module = "ndtgrid._core", frozen)]
+#[derive(Clone)]
 pub struct PyStep {
     pose: [f64; 3],
     prediction: [f64; 3],
@@ -41,6 +42,20 @@ pub struct PyStep {
     #[pyo3(get)]
     num_points: usize,
 }
+
+/// Every field of a [`PyStep`], in declaration order: what pickle keeps.
+type StepState = (
+    [f64; 3],
+    [f64; 3],
+    bool,
+    bool,
+    bool,
+    bool,
+    bool,
+    u32,
+    usize,
+    usize,
+);
 
 impl From<StepOutcome> for PyStep {
     fn from(s: StepOutcome) -> Self {
@@ -71,6 +86,53 @@ impl PyStep {
     #[getter]
     fn prediction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vec3(py, self.prediction)
+    }
+
+    /// Pickle (and `copy`): `_restore` and every field.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (StepState,))> {
+        let s = slf.get().clone();
+        let state = (
+            s.pose,
+            s.prediction,
+            s.matched,
+            s.accepted,
+            s.multi_start,
+            s.inserted,
+            s.converged,
+            s.iterations,
+            s.num_matched,
+            s.num_points,
+        );
+        Ok((slf.get_type().getattr("_restore")?, (state,)))
+    }
+
+    /// The step `__reduce__` took apart.
+    #[classmethod]
+    fn _restore(_cls: &Bound<'_, PyType>, state: StepState) -> Self {
+        let (
+            pose,
+            prediction,
+            matched,
+            accepted,
+            multi_start,
+            inserted,
+            converged,
+            iterations,
+            num_matched,
+            num_points,
+        ) = state;
+        Self {
+            pose,
+            prediction,
+            matched,
+            accepted,
+            multi_start,
+            inserted,
+            converged,
+            iterations,
+            num_matched,
+            num_points,
+        }
     }
 
     fn __repr__(&self) -> String {

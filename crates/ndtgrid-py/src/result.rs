@@ -3,11 +3,13 @@
 use ndt_core::MatchResult;
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
+use pyo3::types::PyType;
 
 use crate::convert::{mat3, rows, vec3};
 
 /// The outcome of :meth:`NdtGrid.match` (see the stub for field docs).
 #[pyclass(name = "MatchResult", module = "ndtgrid._core", frozen)]
+#[derive(Clone)]
 pub struct PyMatchResult {
     pose: [f64; 3],
     #[pyo3(get)]
@@ -22,6 +24,18 @@ pub struct PyMatchResult {
     covariance: [[f64; 3]; 3],
     unconstrained: Vec<[f64; 3]>,
 }
+
+/// Every field of a [`PyMatchResult`], in declaration order: what pickle keeps.
+type State = (
+    [f64; 3],
+    bool,
+    u32,
+    f64,
+    usize,
+    [[f64; 3]; 3],
+    [[f64; 3]; 3],
+    Vec<[f64; 3]>,
+);
 
 impl From<MatchResult> for PyMatchResult {
     fn from(r: MatchResult) -> Self {
@@ -69,6 +83,39 @@ impl PyMatchResult {
     #[getter]
     fn degenerate(&self) -> bool {
         !self.unconstrained.is_empty()
+    }
+
+    /// Pickle (and `copy`): `_restore` and every field.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (State,))> {
+        let r = slf.get().clone();
+        let state = (
+            r.pose,
+            r.converged,
+            r.iterations,
+            r.score,
+            r.num_matched,
+            r.hessian,
+            r.covariance,
+            r.unconstrained,
+        );
+        Ok((slf.get_type().getattr("_restore")?, (state,)))
+    }
+
+    /// The result `__reduce__` took apart.
+    #[classmethod]
+    fn _restore(_cls: &Bound<'_, PyType>, state: State) -> Self {
+        let (pose, converged, iterations, score, num_matched, hessian, covariance, unconstrained) =
+            state;
+        Self {
+            pose,
+            converged,
+            iterations,
+            score,
+            num_matched,
+            hessian,
+            covariance,
+            unconstrained,
+        }
     }
 
     fn __repr__(&self) -> String {

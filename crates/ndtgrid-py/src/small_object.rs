@@ -4,10 +4,11 @@
 use ndt_core::{RemovalCounts, SmallObject};
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyType};
 
 /// One detected small object (see the stub).
 #[pyclass(name = "SmallObject", module = "ndtgrid._core", frozen)]
+#[derive(Clone)]
 pub struct PySmallObject {
     center: [f64; 2],
     cells: Vec<f64>,
@@ -46,6 +47,27 @@ impl PySmallObject {
     #[getter]
     fn cells<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         PyArray1::from_slice(py, &self.cells).reshape([self.cells.len() / 2, 2])
+    }
+
+    /// Pickle (and `copy`): `_restore` and every field.
+    #[allow(clippy::type_complexity)]
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (([f64; 2], Vec<f64>, u64),))> {
+        let o = slf.get().clone();
+        let state = (o.center, o.cells, o.num_points);
+        Ok((slf.get_type().getattr("_restore")?, (state,)))
+    }
+
+    /// The object `__reduce__` took apart.
+    #[classmethod]
+    fn _restore(_cls: &Bound<'_, PyType>, state: ([f64; 2], Vec<f64>, u64)) -> Self {
+        let (center, cells, num_points) = state;
+        Self {
+            center,
+            cells,
+            num_points,
+        }
     }
 
     fn __repr__(&self) -> String {
@@ -117,6 +139,30 @@ impl PyRemovalCounts {
             d.set_item(k, v)?;
         }
         Ok(d)
+    }
+
+    /// Pickle (and `copy`): `_restore` and the counts in `as_dict`'s order.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, ([u64; 9],))> {
+        let counts = slf.get().inner.entries().map(|(_, v)| v);
+        Ok((slf.get_type().getattr("_restore")?, (counts,)))
+    }
+
+    /// The counts `__reduce__` took apart.
+    #[classmethod]
+    fn _restore(_cls: &Bound<'_, PyType>, counts: [u64; 9]) -> Self {
+        let [behind_com_points, behind_com_cells, forefront_points, forefront_cells, area1_cells, backshift_points, backshift_cells, observation_cells, confirmation_cells] =
+            counts;
+        Self::from(RemovalCounts {
+            behind_com_points,
+            behind_com_cells,
+            forefront_points,
+            forefront_cells,
+            area1_cells,
+            backshift_points,
+            backshift_cells,
+            observation_cells,
+            confirmation_cells,
+        })
     }
 
     fn __repr__(&self) -> String {
