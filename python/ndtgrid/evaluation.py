@@ -210,7 +210,14 @@ class RelationErrors:
     rotation: F64
 
     def summary(self) -> RelationSummary:
-        """Mean ± std and max of both errors (NaN when there is no relation)."""
+        """Mean ± std and max of both errors.
+
+        Returns
+        -------
+        RelationSummary
+            Translation [m] and rotation [deg] statistics and the number of relations
+            (NaN statistics when there is none).
+        """
 
         def stats(v: F64) -> tuple[float, float, float]:
             if v.size == 0:

@@ -392,7 +392,13 @@ class Odometry:
         return len(self._loop)
 
     def grid(self) -> NdtGrid:
-        """A copy of the map the scans are matched against."""
+        """A copy of the map the scans are matched against.
+
+        Returns
+        -------
+        NdtGrid
+            The loop's matching grid as it is now (later steps do not change it).
+        """
         grid: NdtGrid = self._loop.grid()
         return grid
 

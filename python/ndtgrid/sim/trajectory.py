@@ -177,7 +177,13 @@ def scan_ranges(
 
     Parameters
     ----------
-    world, laser, poses, seed
+    world : World
+        As for :func:`simulate`.
+    laser : Laser
+        As for :func:`simulate`.
+    poses : array_like, shape (T, 3)
+        As for :func:`simulate`.
+    seed : int, default 0
         As for :func:`simulate`.
 
     Yields

@@ -91,7 +91,18 @@ class World:
         return tuple(m for m, s in zip(self.materials, self.small) if s)
 
     def with_box(self, x0: float, y0: float, x1: float, y1: float) -> World:
-        """A copy with an axis-aligned box ``[x0, x1] x [y0, y1]`` [m] added."""
+        """A copy with an axis-aligned box added.
+
+        Parameters
+        ----------
+        x0, y0, x1, y1 : float
+            Corners of the box ``[x0, x1] x [y0, y1]`` [m].
+
+        Returns
+        -------
+        World
+            This world with the box's four walls added to ``segments``.
+        """
         box = np.array(
             [[x0, y0, x1, y0], [x1, y0, x1, y1], [x1, y1, x0, y1], [x0, y1, x0, y0]],
             dtype=np.float64,
@@ -99,7 +110,22 @@ class World:
         return replace(self, segments=np.vstack([self.segments, box]))
 
     def with_circle(self, x: float, y: float, radius: float, material: str = "") -> World:
-        """A copy with a circle (a stick if thinner than :data:`SMALL_DIAMETER`) added."""
+        """A copy with a circle added (a stick if thinner than :data:`SMALL_DIAMETER`).
+
+        Parameters
+        ----------
+        x, y : float
+            Centre [m].
+        radius : float
+            Radius [m].
+        material : str, default ""
+            Its material (e.g. ``"wood"``, ``"iron"``; see ``materials``).
+
+        Returns
+        -------
+        World
+            This world with the circle added to ``circles``.
+        """
         return replace(
             self,
             circles=np.vstack([self.circles, [[x, y, radius]]]),
@@ -107,7 +133,18 @@ class World:
         )
 
     def translated(self, dx: float, dy: float) -> World:
-        """A copy moved by ``(dx, dy)`` [m] (surfaces, sticks and tour)."""
+        """A copy moved by ``(dx, dy)``: surfaces, sticks and tour.
+
+        Parameters
+        ----------
+        dx, dy : float
+            Translation [m].
+
+        Returns
+        -------
+        World
+            The moved world.
+        """
         shift = np.array([dx, dy], dtype=np.float64)
         return replace(
             self,
@@ -146,7 +183,18 @@ class World:
         return best
 
     def surface_points(self, spacing: float = 0.005) -> F64:
-        """Points on every surface, about ``spacing`` [m] apart, shape (N, 2) (for plots)."""
+        """Points on every surface (for plots).
+
+        Parameters
+        ----------
+        spacing : float, default 0.005
+            Distance between neighbouring points along a surface [m] (about).
+
+        Returns
+        -------
+        ndarray, shape (N, 2)
+            The points [m], wall by wall, then circle by circle.
+        """
         out = []
         for x0, y0, x1, y1 in self.segments:
             n = max(2, int(np.hypot(x1 - x0, y1 - y0) / spacing) + 1)
