@@ -3,6 +3,8 @@ typed user's code sees them."""
 
 from __future__ import annotations
 
+import ast
+import inspect
 import re
 import subprocess
 import sys
@@ -10,7 +12,9 @@ from pathlib import Path
 
 import pytest
 
-pytest.importorskip("mypy", reason="mypy (the test extra) checks the stubs")
+from ndtgrid import _core
+
+STUB = Path(_core.__file__).with_name("_core.pyi")
 
 #: The oldest Python that mypy 2 checks for; the package supports 3.9.
 OLDEST = "3.10"
@@ -44,10 +48,41 @@ BAD = {
 }
 
 
+def documented() -> list[tuple[str, object, str]]:
+    """Every class, method and function the stubs give a docstring: its name, the
+    compiled object and the docstring."""
+    out: list[tuple[str, object, str]] = []
+    for node in ast.parse(STUB.read_text()).body:
+        if isinstance(node, ast.ClassDef) and not node.name.startswith("_"):
+            cls = getattr(_core, node.name)
+            out.append((node.name, cls, ast.get_docstring(node) or ""))
+            out += [
+                (f"{node.name}.{m.name}", getattr(cls, m.name), ast.get_docstring(m) or "")
+                for m in node.body
+                if isinstance(m, ast.FunctionDef)
+                and ast.get_docstring(m)
+                # Slots (``len()``) keep Python's own docstrings.
+                and m.name not in ("__len__",)
+            ]
+        elif isinstance(node, ast.FunctionDef) and ast.get_docstring(node):
+            out.append((node.name, getattr(_core, node.name), ast.get_docstring(node) or ""))
+    return out
+
+
+def test_help_shows_the_stubs_docstrings() -> None:
+    """``help()`` and ``?`` show the compiled objects' docstrings: each is the one
+    the stubs give (the build copies them), not a shorter text of the binding's."""
+    items = documented()
+    assert len(items) >= 60
+    for name, obj, doc in items:
+        assert inspect.cleandoc(obj.__doc__ or "") == doc, name
+
+
 def test_stubs_match_the_compiled_core() -> None:
     """``mypy.stubtest``: every name, parameter and default of ``_core.pyi`` is the
     compiled module's (what ``help()`` shows), and every public name of the module
     is in the stubs."""
+    pytest.importorskip("mypy", reason="mypy (the test extra) checks the stubs")
     r = subprocess.run(
         [sys.executable, "-m", "mypy.stubtest", "ndtgrid._core"],
         capture_output=True,
@@ -61,6 +96,7 @@ def test_typed_code_checks_as_the_core_runs(tmp_path: Path) -> None:
     calls the core accepts pass (a (K, N, 2) array of scans too), and a misspelt
     option, a wrong option type and a subclass of a class the core cannot subclass
     are errors."""
+    pytest.importorskip("mypy", reason="mypy (the test extra) checks the stubs")
     good = tmp_path / "good.py"
     good.write_text(GOOD)
     bad = tmp_path / "bad.py"

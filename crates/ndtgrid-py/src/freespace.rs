@@ -13,7 +13,7 @@ use crate::errors::{poisoned, to_py};
 /// `(image (H, W) int8, origin (2,))` as returned by `raster`.
 type RasterArrays<'py> = (Bound<'py, PyArray2<i8>>, Bound<'py, PyArray1<f64>>);
 
-/// Free space traced from laser beams (see the stub for the documentation).
+#[doc = stub_doc!("FreeSpace")]
 #[pyclass(name = "FreeSpace", module = "ndtgrid._core", frozen)]
 pub struct PyFreeSpace {
     inner: Mutex<FreeSpace>,
@@ -35,7 +35,7 @@ impl PyFreeSpace {
         })
     }
 
-    /// Cell size \[m\].
+    #[doc = stub_doc!("FreeSpace.resolution")]
     #[getter]
     fn resolution(&self) -> PyResult<f64> {
         Ok(self.lock()?.resolution())
@@ -45,7 +45,7 @@ impl PyFreeSpace {
         Ok(self.lock()?.len())
     }
 
-    /// Adds the beams from the sensor at `pose` to the scan-frame `points`.
+    #[doc = stub_doc!("FreeSpace.add_scan")]
     fn add_scan(
         &self,
         py: Python<'_>,
@@ -62,7 +62,7 @@ impl PyFreeSpace {
         })
     }
 
-    /// Dense occupancy image and its origin.
+    #[doc = stub_doc!("FreeSpace.raster")]
     #[pyo3(signature = (occupied, *, max_cells = 100_000_000))]
     fn raster<'py>(
         &self,

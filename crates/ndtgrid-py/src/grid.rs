@@ -30,7 +30,7 @@ type Terms<'py> = (
 /// `(centres, counts)` as returned by `cells`.
 type Cells<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<i64>>);
 
-/// Sparse, unbounded NDT grid map (see the stub for the documentation).
+#[doc = stub_doc!("NdtGrid")]
 #[pyclass(name = "NdtGrid", module = "ndtgrid._core", frozen)]
 pub struct PyNdtGrid {
     inner: Arc<RwLock<NdtGrid>>,
@@ -88,13 +88,13 @@ impl PyNdtGrid {
         })
     }
 
-    /// Number of pyramid levels kept (fine level included).
+    #[doc = stub_doc!("NdtGrid.levels")]
     #[getter]
     fn levels(&self, py: Python<'_>) -> PyResult<usize> {
         self.read(py, NdtGrid::levels)
     }
 
-    /// Cell size \[m\].
+    #[doc = stub_doc!("NdtGrid.cell_size")]
     #[getter]
     fn cell_size(&self, py: Python<'_>) -> PyResult<f64> {
         self.read(py, NdtGrid::cell_size)
@@ -104,7 +104,7 @@ impl PyNdtGrid {
         self.read(py, NdtGrid::len)
     }
 
-    /// Heap bytes held (estimate): every pyramid level and the prepared distributions.
+    #[doc = stub_doc!("NdtGrid.memory_bytes")]
     #[getter]
     fn memory_bytes(&self, py: Python<'_>) -> PyResult<usize> {
         self.read(py, NdtGrid::heap_bytes)
@@ -116,7 +116,7 @@ impl PyNdtGrid {
         })
     }
 
-    /// eq. (6): adds scan-frame points seen from `pose`.
+    #[doc = stub_doc!("NdtGrid.insert")]
     fn insert(
         &self,
         py: Python<'_>,
@@ -133,8 +133,7 @@ impl PyNdtGrid {
         .map_err(to_py)
     }
 
-    /// eq. (6) for many scans in one call: the coarser levels and prepared
-    /// distributions brought up to date once (see the core's `insert_many`).
+    #[doc = stub_doc!("NdtGrid.insert_many")]
     fn insert_many(
         &self,
         py: Python<'_>,
@@ -152,7 +151,7 @@ impl PyNdtGrid {
             .map_err(to_py)
     }
 
-    /// Matches scan-frame points against the map from `guess`.
+    #[doc = stub_doc!("NdtGrid.match")]
     #[pyo3(name = "match", signature = (
         points, guess, *, expansion = 10.0, sigma_floor = 0.02, shape_cell = 0.32, neighbor_search = true, fuse_minority = true,
         pair_neighbors = false, search_radius = 1, max_iterations = 50, translation_tolerance = 1e-4,
@@ -239,7 +238,7 @@ impl PyNdtGrid {
         .map_err(to_py)
     }
 
-    /// Matches many scans, each from its guess, spread over threads (see the stub).
+    #[doc = stub_doc!("NdtGrid.match_many")]
     #[pyo3(signature = (scans, guesses, *, threads = None, **options))]
     fn match_many(
         &self,
@@ -266,7 +265,7 @@ impl PyNdtGrid {
         .map_err(to_py)
     }
 
-    /// Score terms of eq. (1) at `pose` without solving.
+    #[doc = stub_doc!("NdtGrid.evaluate")]
     #[pyo3(signature = (
         points, pose, *, expansion = 10.0, sigma_floor = 0.02, shape_cell = 0.32, neighbor_search = true, fuse_minority = true,
         pair_neighbors = false, search_radius = 1
@@ -315,7 +314,7 @@ impl PyNdtGrid {
         ))
     }
 
-    /// `(K, 2)` cell centres and `(K,)` point counts, sorted by cell index.
+    #[doc = stub_doc!("NdtGrid.cells")]
     fn cells<'py>(&self, py: Python<'py>) -> PyResult<Cells<'py>> {
         let (centres, counts) = self.read(py, |g| {
             let s = g.cell_size();
@@ -336,8 +335,7 @@ impl PyNdtGrid {
         ))
     }
 
-    /// The eq. (6) sums of every cell in map coordinates: `(K, 2)` int64 cell
-    /// indices, `(K,)` counts `M`, `(K, 2)` sums `m`, `(K, 2, 2)` sums `S`.
+    #[doc = stub_doc!("NdtGrid.cell_statistics")]
     fn cell_statistics<'py>(&self, py: Python<'py>) -> PyResult<crate::state::StateArrays<'py>> {
         let flat = self.read(py, |g| {
             let recs = g.cells();
@@ -346,13 +344,13 @@ impl PyNdtGrid {
         crate::state::to_arrays(py, flat)
     }
 
-    /// The exact cell state (sums about each cell's centre), sorted by index.
+    #[doc = stub_doc!("NdtGrid.cell_states")]
     fn cell_states<'py>(&self, py: Python<'py>) -> PyResult<crate::state::StateArrays<'py>> {
         let v = self.read(py, crate::state::flatten)?;
         crate::state::to_arrays(py, v)
     }
 
-    /// A grid holding exactly the given cell states.
+    #[doc = stub_doc!("NdtGrid.from_cell_states")]
     #[staticmethod]
     fn from_cell_states(
         cell_size: f64,
@@ -364,13 +362,13 @@ impl PyNdtGrid {
         crate::state::from_arrays(cell_size, indices, counts, sums, scatters).map(Self::from)
     }
 
-    /// The bytes of a grid file (what `save` writes).
+    #[doc = stub_doc!("NdtGrid.to_bytes")]
     fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
         let bytes = self.read(py, NdtGrid::to_bytes)?.map_err(to_py)?;
         Ok(PyBytes::new(py, &bytes))
     }
 
-    /// The grid of a grid file's bytes.
+    #[doc = stub_doc!("NdtGrid.from_bytes")]
     #[classmethod]
     fn from_bytes(_cls: &Bound<'_, PyType>, py: Python<'_>, data: &[u8]) -> PyResult<Self> {
         py.detach(|| NdtGrid::from_bytes(data))
@@ -378,14 +376,14 @@ impl PyNdtGrid {
             .map_err(to_py)
     }
 
-    /// Saves the grid to a file, atomically.
+    #[doc = stub_doc!("NdtGrid.save")]
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let bytes = self.read(py, NdtGrid::to_bytes)?.map_err(to_py)?;
         py.detach(|| ndt_core::persist::write_atomic(&path, &bytes))
             .map_err(to_py)
     }
 
-    /// Loads a grid saved by `save`.
+    #[doc = stub_doc!("NdtGrid.load")]
     #[classmethod]
     fn load(_cls: &Bound<'_, PyType>, py: Python<'_>, path: PathBuf) -> PyResult<Self> {
         py.detach(|| NdtGrid::load(&path))

@@ -3,8 +3,7 @@
 
 use pyo3::prelude::*;
 
-/// `"AVX-512"`, `"AVX2"` or `"NEON"`: the vector extension of the core's
-/// kernels here; `None` for their generic build.
+#[doc = stub_doc!("vector_extension")]
 #[pyfunction]
 pub fn vector_extension() -> Option<&'static str> {
     ndt_core::kernels::vector_extension().map(|v| v.name())

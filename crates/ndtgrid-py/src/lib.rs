@@ -1,6 +1,18 @@
 //! The thin PyO3 layer of ndtgrid (`ndtgrid._core`): conversion, validation
 //! and error mapping around `ndt-core`; no algorithm lives here.
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+// The Python-facing items take the stubs' numpydoc docstrings (`stub_doc!`),
+// which are not Markdown.
+#![allow(clippy::doc_lazy_continuation)]
+
+/// The Python docstring the type stubs give `$name` (`"Class"`,
+/// `"Class.method"` or `"function"`), as the build script copied it: the
+/// stubs are where the Python documentation is written (see `build.rs`).
+macro_rules! stub_doc {
+    ($name:literal) => {
+        include_str!(concat!(env!("OUT_DIR"), "/doc/", $name, ".txt"))
+    };
+}
 
 mod convert;
 mod errors;

@@ -18,7 +18,7 @@ use crate::grid::{PyNdtGrid, Reduced};
 use crate::mapper_options::PyMapperOptions;
 use crate::small_object::{PyRemovalCounts, PySmallObject};
 
-/// NDT grid map fed through the §V elimination (see the stub).
+#[doc = stub_doc!("Mapper")]
 #[pyclass(name = "Mapper", module = "ndtgrid._core", frozen)]
 pub struct PyMapper {
     grid: Arc<RwLock<NdtGrid>>,
@@ -109,25 +109,25 @@ impl PyMapper {
         })
     }
 
-    /// The map matched against: an `NdtGrid` sharing this mapper's cells.
+    #[doc = stub_doc!("Mapper.grid")]
     #[getter]
     fn grid(&self, py: Python<'_>) -> Py<PyNdtGrid> {
         self.grid_handle.clone_ref(py)
     }
 
-    /// The options in force.
+    #[doc = stub_doc!("Mapper.options")]
     #[getter]
     fn options(&self, py: Python<'_>) -> Py<PyMapperOptions> {
         self.options.clone_ref(py)
     }
 
-    /// Cell size \[m\].
+    #[doc = stub_doc!("Mapper.cell_size")]
     #[getter]
     fn cell_size(&self, py: Python<'_>) -> PyResult<f64> {
         self.with_both(py, |g, _| g.cell_size())
     }
 
-    /// Scans inserted so far.
+    #[doc = stub_doc!("Mapper.scan_count")]
     #[getter]
     fn scan_count(&self, py: Python<'_>) -> PyResult<u64> {
         self.with_both(py, |_, f| f.scans())
@@ -150,7 +150,7 @@ impl PyMapper {
         })
     }
 
-    /// Adds one scan through the §V elimination.
+    #[doc = stub_doc!("Mapper.insert_scan")]
     fn insert_scan(
         &self,
         py: Python<'_>,
@@ -171,7 +171,7 @@ impl PyMapper {
             .map_err(to_py)
     }
 
-    /// `(K, 2)` centres of the occupied cells, sorted by cell index.
+    #[doc = stub_doc!("Mapper.occupied_cells")]
     fn occupied_cells<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let flat = self.with_both(py, |g, _| {
             let s = g.cell_size();
@@ -188,7 +188,7 @@ impl PyMapper {
         PyArray1::from_vec(py, flat).reshape([k, 2])
     }
 
-    /// The detected small objects.
+    #[doc = stub_doc!("Mapper.small_objects")]
     fn small_objects(&self, py: Python<'_>) -> PyResult<Vec<PySmallObject>> {
         self.with_both(py, |g, f| {
             let s = g.cell_size();
@@ -199,17 +199,17 @@ impl PyMapper {
         })
     }
 
-    /// What each step removed so far.
+    #[doc = stub_doc!("Mapper.removal_counts")]
     fn removal_counts(&self, py: Python<'_>) -> PyResult<PyRemovalCounts> {
         self.with_both(py, |_, f| PyRemovalCounts::from(f.removal_counts()))
     }
 
-    /// Runs the periodic checks (b-1, c) now; returns the cells deleted.
+    #[doc = stub_doc!("Mapper.run_checks")]
     fn run_checks(&self, py: Python<'_>) -> PyResult<usize> {
         self.with_both_mut(py, |g, f| f.run_checks(g))
     }
 
-    /// The bytes of a mapper file (what `save` writes).
+    #[doc = stub_doc!("Mapper.to_bytes")]
     fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
         let bytes = self
             .with_both(py, ndt_core::persist::mapper_to_bytes)?
@@ -217,7 +217,7 @@ impl PyMapper {
         Ok(PyBytes::new(py, &bytes))
     }
 
-    /// The mapper of a mapper file's bytes.
+    #[doc = stub_doc!("Mapper.from_bytes")]
     #[classmethod]
     fn from_bytes(_cls: &Bound<'_, PyType>, py: Python<'_>, data: &[u8]) -> PyResult<Self> {
         let (grid, filter) = py
@@ -226,7 +226,7 @@ impl PyMapper {
         Self::from_parts(py, grid, filter)
     }
 
-    /// Saves the mapper (grid and filter state) to a file, atomically.
+    #[doc = stub_doc!("Mapper.save")]
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let bytes = self
             .with_both(py, ndt_core::persist::mapper_to_bytes)?
@@ -235,7 +235,7 @@ impl PyMapper {
             .map_err(to_py)
     }
 
-    /// Loads a mapper saved by `save`.
+    #[doc = stub_doc!("Mapper.load")]
     #[classmethod]
     fn load(_cls: &Bound<'_, PyType>, py: Python<'_>, path: PathBuf) -> PyResult<Self> {
         let (grid, filter) = py

@@ -67,12 +67,12 @@ impl PyMapperOptions {
         Ok(Self::from(options))
     }
 
-    /// Every option by name, in declaration order.
+    #[doc = stub_doc!("MapperOptions.as_dict")]
     fn as_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         options_dict(py, &self.core())
     }
 
-    /// A copy with some options changed (like `dataclasses.replace`).
+    #[doc = stub_doc!("MapperOptions.replace")]
     #[pyo3(signature = (**changes))]
     fn replace<'py>(
         &self,
@@ -93,7 +93,7 @@ impl PyMapperOptions {
         py.get_type::<PyMapperOptions>().call((), Some(&all))
     }
 
-    /// Pickle (and `copy`): `_restore` and `as_dict`.
+    #[doc = stub_doc!("MapperOptions.__reduce__")]
     fn __reduce__<'py>(
         slf: &Bound<'py, Self>,
     ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyDict>,))> {
@@ -125,7 +125,7 @@ impl PyMapperOptions {
 /// struct in the conversion makes a forgotten option a compile error.
 macro_rules! options_class {
     ($($name:ident : $t:ty),* $(,)?) => {
-        /// The options of the §V elimination (see the stub for every field).
+        #[doc = stub_doc!("MapperOptions")]
         #[pyclass(name = "MapperOptions", module = "ndtgrid._core", frozen, eq)]
         #[derive(Clone, PartialEq)]
         pub struct PyMapperOptions {
@@ -176,8 +176,7 @@ options_class!(
     pass_radius: f64,
 );
 
-/// The core's default mapper options, so the Python layer and its tests can
-/// check that the documented defaults are the ones in force.
+#[doc = stub_doc!("default_mapper_options")]
 #[pyfunction]
 pub fn default_mapper_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     options_dict(py, &MapperOptions::default())

@@ -9,16 +9,13 @@ use pyo3::types::PyDict;
 
 use crate::convert::{count, level_mask, level_tuple};
 
-/// The core's default match options, so the Python layer and its tests can
-/// check that the documented defaults are the ones in force.
+#[doc = stub_doc!("default_match_options")]
 #[pyfunction]
 pub fn default_match_options(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     options_dict(py, &MatchOptions::default())
 }
 
-/// The core's options of the paper's method alone (`MatchOptions::paper`)
-/// and of the original NDT (`MatchOptions::original_ndt`), so that the
-/// Python presets can be checked against them.
+#[doc = stub_doc!("preset_match_options")]
 #[pyfunction]
 pub fn preset_match_options<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>> {
     match name {

@@ -13,13 +13,13 @@ use crate::convert::{count, level_mask, level_tuple, pose, vec3, vector};
 use crate::errors::{poisoned, to_py};
 use crate::grid::PyNdtGrid;
 
-/// The scan-to-map odometry loop (see the stub for the documentation).
+#[doc = stub_doc!("OdometryLoop")]
 #[pyclass(name = "OdometryLoop", module = "ndtgrid._core", frozen)]
 pub struct PyOdometry {
     inner: Mutex<Odometry>,
 }
 
-/// One step of the loop (see the stub for field docs).
+#[doc = stub_doc!("OdometryStep")]
 #[pyclass(name = "OdometryStep", module = "ndtgrid._core", frozen)]
 #[derive(Clone)]
 pub struct PyStep {
@@ -88,7 +88,7 @@ impl PyStep {
         vec3(py, self.prediction)
     }
 
-    /// Pickle (and `copy`): `_restore` and every field.
+    #[doc = stub_doc!("OdometryStep.__reduce__")]
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (StepState,))> {
         let s = slf.get().clone();
         let state = (
@@ -305,7 +305,7 @@ impl PyOdometry {
         })
     }
 
-    /// Processes one scan; returns what was done.
+    #[doc = stub_doc!("OdometryLoop.step")]
     #[pyo3(signature = (ranges, angles, odom = None))]
     fn step(
         &self,
@@ -329,7 +329,7 @@ impl PyOdometry {
         .map(PyStep::from)
     }
 
-    /// `(T, 3)` pose of every scan so far.
+    #[doc = stub_doc!("OdometryLoop.poses")]
     #[getter]
     fn poses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let flat: Vec<f64> = self.with(py, |o| {
@@ -339,13 +339,13 @@ impl PyOdometry {
         PyArray1::from_vec(py, flat).reshape([t, 3])
     }
 
-    /// Scans added to the map so far.
+    #[doc = stub_doc!("OdometryLoop.insertions")]
     #[getter]
     fn insertions(&self, py: Python<'_>) -> PyResult<u64> {
         self.with(py, Odometry::insertions)
     }
 
-    /// Scans the grid the loop matches against took so far.
+    #[doc = stub_doc!("OdometryLoop.grid_insertions")]
     #[getter]
     fn grid_insertions(&self, py: Python<'_>) -> PyResult<u64> {
         self.with(py, Odometry::grid_insertions)
@@ -356,18 +356,18 @@ impl PyOdometry {
         self.with(py, |o| o.grid().len())
     }
 
-    /// A copy of the map.
+    #[doc = stub_doc!("OdometryLoop.grid")]
     fn grid(&self, py: Python<'_>) -> PyResult<PyNdtGrid> {
         let grid = self.with(py, |o| o.grid().clone())?;
         Ok(PyNdtGrid::from(grid))
     }
 
-    /// Waits until a background mapper has taken in every inserted scan.
+    #[doc = stub_doc!("OdometryLoop.wait_for_mapper")]
     fn wait_for_mapper(&self, py: Python<'_>) -> PyResult<()> {
         self.with(py, Odometry::wait_for_mapper)
     }
 
-    /// A copy of the mapper (grid and §V filter state) as of this call.
+    #[doc = stub_doc!("OdometryLoop.mapper")]
     fn mapper(&self, py: Python<'_>) -> PyResult<crate::mapper::PyMapper> {
         let mapper = self
             .with(py, |o| o.mapper().map(|m| ndt_core::Mapper::clone(&m)))?
@@ -375,7 +375,7 @@ impl PyOdometry {
         crate::mapper::PyMapper::from_core(py, mapper)
     }
 
-    /// The settings in force, as keyword arguments of the constructor.
+    #[doc = stub_doc!("OdometryLoop.config")]
     fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let c = self.with(py, |o| *o.config())?;
         config_dict(py, &c)
@@ -428,7 +428,7 @@ fn config_dict<'py>(py: Python<'py>, c: &OdometryConfig) -> PyResult<Bound<'py, 
     Ok(out)
 }
 
-/// The core's default odometry settings (keyword arguments of `OdometryLoop`).
+#[doc = stub_doc!("default_odometry_config")]
 #[pyfunction]
 pub fn default_odometry_config(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     config_dict(py, &OdometryConfig::default())

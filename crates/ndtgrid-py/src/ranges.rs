@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use crate::convert::vector;
 use crate::errors::to_py;
 
-/// `(N, 2)` scan-frame points of the valid beams (see the stub).
+#[doc = stub_doc!("ranges_to_points")]
 #[pyfunction]
 #[pyo3(signature = (ranges, angles, *, min_range = 0.0, max_range = f64::INFINITY))]
 pub fn ranges_to_points<'py>(

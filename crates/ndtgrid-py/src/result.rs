@@ -7,7 +7,7 @@ use pyo3::types::PyType;
 
 use crate::convert::{mat3, rows, vec3};
 
-/// The outcome of :meth:`NdtGrid.match` (see the stub for field docs).
+#[doc = stub_doc!("MatchResult")]
 #[pyclass(name = "MatchResult", module = "ndtgrid._core", frozen)]
 #[derive(Clone)]
 pub struct PyMatchResult {
@@ -85,7 +85,7 @@ impl PyMatchResult {
         !self.unconstrained.is_empty()
     }
 
-    /// Pickle (and `copy`): `_restore` and every field.
+    #[doc = stub_doc!("MatchResult.__reduce__")]
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (State,))> {
         let r = slf.get().clone();
         let state = (

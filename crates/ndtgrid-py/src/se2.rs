@@ -12,7 +12,7 @@ fn arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Pose2> {
     Ok(Pose2::new(p[0], p[1], p[2]))
 }
 
-/// `a ∘ b`: the pose `b` (given in frame `a`) expressed in `a`'s parent frame.
+#[doc = stub_doc!("compose")]
 #[pyfunction]
 pub fn compose<'py>(
     a: &Bound<'py, PyAny>,
@@ -21,13 +21,13 @@ pub fn compose<'py>(
     Ok(vec3(a.py(), arg(a, "a")?.compose(arg(b, "b")?).to_array()))
 }
 
-/// The inverse motion of `p`.
+#[doc = stub_doc!("inverse")]
 #[pyfunction]
 pub fn inverse<'py>(p: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<f64>>> {
     Ok(vec3(p.py(), arg(p, "p")?.inverse().to_array()))
 }
 
-/// `a⁻¹ ∘ b`: the motion from `a` to `b` in `a`'s frame (an odometry increment).
+#[doc = stub_doc!("between")]
 #[pyfunction]
 pub fn between<'py>(
     a: &Bound<'py, PyAny>,

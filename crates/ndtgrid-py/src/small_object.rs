@@ -6,7 +6,7 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyType};
 
-/// One detected small object (see the stub).
+#[doc = stub_doc!("SmallObject")]
 #[pyclass(name = "SmallObject", module = "ndtgrid._core", frozen)]
 #[derive(Clone)]
 pub struct PySmallObject {
@@ -49,7 +49,7 @@ impl PySmallObject {
         PyArray1::from_slice(py, &self.cells).reshape([self.cells.len() / 2, 2])
     }
 
-    /// Pickle (and `copy`): `_restore` and every field.
+    #[doc = stub_doc!("SmallObject.__reduce__")]
     #[allow(clippy::type_complexity)]
     fn __reduce__<'py>(
         slf: &Bound<'py, Self>,
@@ -81,7 +81,7 @@ impl PySmallObject {
     }
 }
 
-/// What each §V step removed so far (see the stub).
+#[doc = stub_doc!("RemovalCounts")]
 #[pyclass(name = "RemovalCounts", module = "ndtgrid._core", frozen)]
 pub struct PyRemovalCounts {
     inner: RemovalCounts,
@@ -132,7 +132,7 @@ impl PyRemovalCounts {
         self.inner.confirmation_cells
     }
 
-    /// Every counter by name, in step order.
+    #[doc = stub_doc!("RemovalCounts.as_dict")]
     fn as_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         for (k, v) in self.inner.entries() {
@@ -141,7 +141,7 @@ impl PyRemovalCounts {
         Ok(d)
     }
 
-    /// Pickle (and `copy`): `_restore` and the counts in `as_dict`'s order.
+    #[doc = stub_doc!("RemovalCounts.__reduce__")]
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, ([u64; 9],))> {
         let counts = slf.get().inner.entries().map(|(_, v)| v);
         Ok((slf.get_type().getattr("_restore")?, (counts,)))
