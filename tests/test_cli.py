@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gzip
 import json
 import math
 import subprocess
@@ -136,6 +137,36 @@ def test_map_on_the_mines_log_with_forced_format(tmp_path: Path) -> None:
     )
     times, _ = read_tum(out / "trajectory.tum")
     assert times.shape == (200,) and times[0] == pytest.approx(212.387282)
+
+
+def test_bad_files_and_values_are_one_line_errors(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A missing, unknown, cut or unreadable file, or a bad value: exit status 1 and one
+    line on stderr naming the command and the file (no traceback); no outputs written."""
+    log = tmp_path / "room.log"
+    carmen_log(log)
+    cut = tmp_path / "cut.log.gz"
+    whole = gzip.compress(log.read_bytes())
+    cut.write_bytes(whole[: len(whole) // 2])
+    out = tmp_path / "out"
+    cases = [
+        (["map", str(tmp_path / "absent.log")], "No such file or directory"),
+        (["map", str(tmp_path)], f"{tmp_path}: a directory without metadata.yaml is not"),
+        (["map", str(log.with_suffix(".png"))], "cannot tell the log format from the name"),
+        (["map", str(cut)], f"{cut}: damaged gzip data after line"),
+        (["map", str(log), "--cell-size", "-1"], "cell_size: expected a finite cell size"),
+        (["eval", "--estimate", str(log), "--reference", str(log)], f"{log}:1: expected 8"),
+    ]
+    for argv, expected in cases:
+        command = argv[0]
+        if command == "map":
+            argv = [*argv, "--out", str(out), "--quiet"]
+        assert main(argv) == 1, argv
+        err = capsys.readouterr().err
+        assert err.startswith(f"ndtgrid {command}: ") and expected in err, (argv, err)
+        assert err.count("\n") == 1, err
+    assert not out.exists()
 
 
 def test_readings_beyond_max_range_are_dropped() -> None:

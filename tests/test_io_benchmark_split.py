@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import math
+import re
 import tarfile
 from pathlib import Path
 
@@ -131,6 +132,24 @@ def test_gap_and_duplicate_members_are_errors(tmp_path: Path) -> None:
     )
     with pytest.raises(ValueError, match=r"b/dataset_0.txt: scan 0 appears twice"):
         list(read_benchmark_split(dup))
+
+
+def test_a_cut_archive_or_another_file_names_the_file(tmp_path: Path) -> None:
+    whole = archive(
+        tmp_path / "x.tar.gz",
+        {f"d/dataset_{k}.txt": member([1.0 + k] * 200, (k, 0, 0)) for k in range(40)},
+    ).read_bytes()
+    cut = tmp_path / "cut.tar.gz"
+    cut.write_bytes(whole[: len(whole) // 2])
+    with pytest.raises(
+        ValueError, match=rf"^{re.escape(str(cut))}: not a readable \.tar\.gz after \d+ scans: "
+    ):
+        list(read_benchmark_split(cut))
+    other = tmp_path / "other.tgz"
+    other.write_text("1 2 3\n")
+    with pytest.raises(ValueError) as info:
+        list(read_benchmark_split(other))
+    assert str(info.value) == f"{other}: not a readable .tar.gz after 0 scans: not a gzip file"
 
 
 def test_other_members_are_skipped_and_bad_arguments_fail_early(tmp_path: Path) -> None:

@@ -6,6 +6,7 @@ import csv
 import dataclasses
 import gzip
 import math
+import re
 import time
 from pathlib import Path
 
@@ -352,6 +353,25 @@ def test_missing_file_raises_at_call(tmp_path: Path) -> None:
         read_carmen(tmp_path / "nope.log")
     with pytest.raises(FileNotFoundError):
         iter_carmen_messages(str(tmp_path / "nope.log.gz"))
+
+
+def test_a_cut_or_damaged_gzip_log_names_the_file_and_the_last_line(tmp_path: Path) -> None:
+    whole = gzip.compress("".join(f"{GOOD}\n" for _ in range(400)).encode())
+    cut = tmp_path / "cut.log.gz"
+    cut.write_bytes(whole[: len(whole) // 2])
+    with pytest.raises(ValueError) as info:
+        list(read_carmen(cut))
+    m = re.fullmatch(
+        rf"{re.escape(str(cut))}: damaged gzip data after line (\d+): Compressed file ended "
+        "before the end-of-stream marker was reached",
+        str(info.value),
+    )
+    assert m is not None, str(info.value)
+    assert 0 < int(m.group(1)) < 400
+    damaged = tmp_path / "damaged.log.gz"
+    damaged.write_bytes(whole[:40] + bytes(b ^ 0xFF for b in whole[40:80]) + whole[80:])
+    with pytest.raises(ValueError, match=rf"^{re.escape(str(damaged))}: damaged gzip data after"):
+        list(iter_carmen_messages(damaged))
 
 
 def test_bad_arguments(tmp_path: Path) -> None:

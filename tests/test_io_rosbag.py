@@ -144,6 +144,19 @@ def test_topic_choice_errors(tmp_path: Path) -> None:
         read_rosbag(tmp_path / "absent.bag")
 
 
+def test_what_is_not_a_bag_is_named(tmp_path: Path) -> None:
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    with pytest.raises(ValueError) as info:
+        read_rosbag(empty)
+    assert str(info.value) == f"{empty}: a directory without metadata.yaml is not a ROS 2 bag"
+    fake = tmp_path / "fake.bag"
+    fake.write_text("hello\n")
+    with pytest.raises(ValueError) as info:
+        list(read_rosbag(fake))
+    assert str(info.value).startswith(f"{fake}: not a readable ROS bag: ")
+
+
 def test_cli_maps_a_bag_and_drops_readings_beyond_range_max(tmp_path: Path) -> None:
     from ndtgrid.cli import main
     from ndtgrid.export import read_tum

@@ -20,6 +20,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import sys
@@ -164,11 +165,34 @@ def map_scans(
     Writes ``map.png``, ``map.pgm`` + ``map.yaml``, ``trajectory.tum`` and ``map.ndtgrid``.
     Returns the odometry and the seconds it took, or ``None`` when there was no scan.
     """
+    # Made first, so that a directory that cannot be made fails before the mapping;
+    # removed again when this run made it and the mapping fails.
+    made = not out.exists()
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        done = _map_into(scans, out, cell_size, resolution, quiet, title)
+    except BaseException:
+        if made:
+            _remove_if_empty(out)
+        raise
+    if done is None and made:
+        _remove_if_empty(out)
+    return done
+
+
+def _remove_if_empty(path: Path) -> None:
+    with contextlib.suppress(OSError):  # not empty (or gone): leave it
+        path.rmdir()
+
+
+def _map_into(
+    scans: Iterable[Scan], out: Path, cell_size: float, resolution: float, quiet: bool, title: str
+) -> tuple[Odometry, float] | None:
+    """The body of :func:`map_scans`, into the directory ``out``, which exists."""
     from ndtgrid import NdtGrid, Odometry
     from ndtgrid._core import FreeSpace
     from ndtgrid.export import occupancy_image, save_map, write_png, write_ros_map, write_tum
 
-    out.mkdir(parents=True, exist_ok=True)
     odo = Odometry(cell_size=cell_size)
     cfg = odo.config
     # The odometry's map is bounded (map_window); the exported map keeps every added scan.
@@ -348,13 +372,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     """
     parser = build_parser()
     args = parser.parse_args(argv)
-    if args.command == "map":
-        return run_map(args)
-    if args.command == "eval":
-        return run_eval(args)
-    if args.command == "demo":
-        return run_demo(args)
-    if args.command == "bench":
-        return run_bench(args)
-    parser.print_help()
-    return 0
+    commands = {"map": run_map, "eval": run_eval, "demo": run_demo, "bench": run_bench}
+    run = commands.get(args.command)
+    if run is None:
+        parser.print_help()
+        return 0
+    try:
+        return run(args)
+    except (OSError, EOFError, ValueError) as err:
+        # A file that is missing, unreadable, truncated or not a log, or a bad
+        # value: the readers' and the core's messages name it, without a traceback.
+        print(f"ndtgrid {args.command}: {err}", file=sys.stderr)
+        return 1

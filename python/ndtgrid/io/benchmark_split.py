@@ -19,6 +19,7 @@ import math
 import os
 import re
 import tarfile
+import zlib
 from collections.abc import Generator
 
 import numpy as np
@@ -64,7 +65,9 @@ def read_benchmark_split(
     ValueError
         If ``fov`` is not in ``(0, 2*pi]``. While iterating: a member that does not follow
         the format (message ``"{path}:{member}:{line}: ..."``), two members with the same
-        ``k``, or a gap in ``k`` (message names the first missing member).
+        ``k``, a gap in ``k`` (message names the first missing member), or a file that is
+        not a gzip-compressed tar or is cut short (``"{path}: not a readable .tar.gz after
+        {n} scans: ..."``).
 
     Notes
     -----
@@ -89,19 +92,25 @@ def read_benchmark_split(
 
 def _scans(name: str, fov: float) -> Generator[Scan, None, None]:
     parsed: dict[int, tuple[F64, F64, str]] = {}
-    with tarfile.open(name, "r:gz") as archive:
-        for member in archive:
-            match = _MEMBER.fullmatch(member.name)
-            if not member.isfile() or match is None:
-                continue
-            k = int(match.group(1))
-            if k in parsed:
-                raise ValueError(f"{name}:{member.name}: scan {k} appears twice")
-            stream = archive.extractfile(member)
-            if stream is None:  # pragma: no cover - isfile() members always have data
-                continue
-            ranges, pose = _parse_member(stream.read(), f"{name}:{member.name}")
-            parsed[k] = (ranges, pose, member.name)
+    try:
+        with tarfile.open(name, "r:gz") as archive:
+            for member in archive:
+                match = _MEMBER.fullmatch(member.name)
+                if not member.isfile() or match is None:
+                    continue
+                k = int(match.group(1))
+                if k in parsed:
+                    raise ValueError(f"{name}:{member.name}: scan {k} appears twice")
+                stream = archive.extractfile(member)
+                if stream is None:  # pragma: no cover - isfile() members always have data
+                    continue
+                ranges, pose = _parse_member(stream.read(), f"{name}:{member.name}")
+                parsed[k] = (ranges, pose, member.name)
+    except (EOFError, tarfile.TarError, zlib.error) as exc:
+        # Not a gzip-compressed tar, or one cut short: named, with what was read.
+        raise ValueError(
+            f"{name}: not a readable .tar.gz after {len(parsed)} scans: {exc}"
+        ) from exc
     for k in range(len(parsed)):
         if k not in parsed:
             raise ValueError(

@@ -31,6 +31,7 @@ from __future__ import annotations
 import gzip
 import math
 import os
+import zlib
 from collections.abc import Generator, Iterable
 from dataclasses import dataclass
 from typing import Callable, TextIO
@@ -156,7 +157,8 @@ def read_carmen(
         If ``lasers`` names an unknown message or ``fov`` is not in ``(0, 2*pi]``. While
         iterating: a malformed laser line (too few or too many fields for its beam count,
         a non-number where a number must be, a non-finite pose or timestamp). The message
-        starts with ``"{path}:{line}: "`` and says what was expected and what came.
+        starts with ``"{path}:{line}: "`` and says what was expected and what came. A
+        gzip stream cut short or damaged: ``"{path}: damaged gzip data after line {n}: "``.
 
     See Also
     --------
@@ -276,26 +278,31 @@ def _open_text(name: str, compressed: bool) -> TextIO:
 def _iter_lines(
     name: str, compressed: bool, lasers: frozenset[str], fov: float, *, with_odom: bool
 ) -> Generator[Scan | OdomRecord, None, None]:
-    with _open_text(name, compressed) as stream:
-        for number, text in enumerate(stream, start=1):
-            tokens = text.split()
-            if not tokens:
-                continue
-            kind = tokens[0]
-            message: Scan | OdomRecord
-            try:
-                if kind in lasers:
-                    if kind in _FLASER_LIKE:
-                        message = _parse_flaser(tokens, number, fov)
-                    else:
-                        message = _parse_robotlaser(tokens, number)
-                elif with_odom and kind == "ODOM":
-                    message = _parse_odom(tokens, number)
-                else:
+    number = 0
+    try:
+        with _open_text(name, compressed) as stream:
+            for number, text in enumerate(stream, start=1):
+                tokens = text.split()
+                if not tokens:
                     continue
-            except _MalformedLineError as exc:
-                raise ValueError(f"{name}:{number}: {exc}") from None
-            yield message
+                kind = tokens[0]
+                message: Scan | OdomRecord
+                try:
+                    if kind in lasers:
+                        if kind in _FLASER_LIKE:
+                            message = _parse_flaser(tokens, number, fov)
+                        else:
+                            message = _parse_robotlaser(tokens, number)
+                    elif with_odom and kind == "ODOM":
+                        message = _parse_odom(tokens, number)
+                    else:
+                        continue
+                except _MalformedLineError as exc:
+                    raise ValueError(f"{name}:{number}: {exc}") from None
+                yield message
+    except (EOFError, gzip.BadGzipFile, zlib.error) as exc:
+        # A truncated or damaged gzip stream: named, with the last line read.
+        raise ValueError(f"{name}: damaged gzip data after line {number}: {exc}") from exc
 
 
 def _scans_only(

@@ -7,6 +7,7 @@ bag is a ``.bag`` file, a ROS 2 bag the directory holding ``metadata.yaml``.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 from collections.abc import Generator
@@ -77,9 +78,11 @@ def read_rosbag(
     FileNotFoundError
         If ``path`` does not exist (raised by this call, before iterating).
     ValueError
-        If there is no LaserScan topic or several and ``scan_topic`` is not given (the
-        message lists them), if a named topic is missing or of another type, or if several
-        Odometry topics exist and ``odom_topic`` is not given.
+        If ``path`` is a directory without ``metadata.yaml`` (raised by this call), or,
+        when iterating starts, not a bag rosbags can open (``"{path}: not a readable ROS
+        bag: ..."``); if there is no LaserScan topic or several and ``scan_topic`` is not
+        given (the message lists them), if a named topic is missing or of another type,
+        or if several Odometry topics exist and ``odom_topic`` is not given.
 
     Notes
     -----
@@ -90,6 +93,8 @@ def read_rosbag(
     p = Path(os.fspath(path))
     if not p.exists():
         raise FileNotFoundError(f"{p}: no such file or directory")
+    if p.is_dir() and not (p / "metadata.yaml").is_file():
+        raise ValueError(f"{p}: a directory without metadata.yaml is not a ROS 2 bag")
     return _scans(highlevel, typesys, p, scan_topic, odom_topic, use_odom)
 
 
@@ -152,7 +157,12 @@ def _scans(
     use_odom: bool,
 ) -> Generator[Scan, None, None]:
     store = typesys.get_typestore(typesys.Stores.ROS2_HUMBLE)
-    with highlevel.AnyReader([path], default_typestore=store) as reader:
+    reader = highlevel.AnyReader([path], default_typestore=store)
+    try:
+        reader.open()
+    except highlevel.AnyReaderError as exc:
+        raise ValueError(f"{path}: not a readable ROS bag: {exc}") from exc
+    with contextlib.closing(reader):
         scans = _pick(reader, LASER_SCAN, scan_topic, required=True)
         odom_conns = _pick(reader, ODOMETRY, odom_topic, required=False) if use_odom else []
         table = _odometry(reader, odom_conns) if odom_conns else np.zeros((0, 4))
