@@ -94,6 +94,63 @@ def test_eval_against_tum_and_index(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert "only 0 reference poses" in capsys.readouterr().err
 
 
+def index_csv(path: Path, raw_scan: np.ndarray, poses: np.ndarray) -> Path:
+    """A benchmark index CSV: corrected scan k is raw scan ``raw_scan[k]`` at pose k."""
+    rows = [
+        "gfs_scan,raw_scan,ipc_ts,logger_ts,corr_x,corr_y,corr_theta,raw_odo_x,raw_odo_y,"
+        "raw_odo_theta"
+    ]
+    for k, (r, p) in enumerate(zip(raw_scan, poses)):
+        rows.append(f"{k},{r},{100.0 + k},{100.0 + k},{p[0]},{p[1]},{p[2]},0,0,0")
+    path.write_text("\n".join(rows) + "\n")
+    return path
+
+
+def test_eval_pairs_scan_numbers_by_the_column_asked_for(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Scan numbers pair by raw_scan (the full-rate log's, the default) or by gfs_scan
+    (the corrected log's) as asked."""
+    ref = room_path(20)
+    index = index_csv(tmp_path / "index.csv", 3 + 7 * np.arange(20), ref)
+    write_tum(tmp_path / "own.tum", np.arange(20.0), ref)  # the corrected log's numbers
+    raw = np.zeros((140, 3))
+    raw[3 + 7 * np.arange(20)] = ref
+    write_tum(tmp_path / "raw.tum", np.arange(140.0), raw)  # the full-rate log's numbers
+    for name, extra in [("raw.tum", []), ("own.tum", ["--reference-time", "gfs_scan"])]:
+        argv = ["eval", "--estimate", str(tmp_path / name), "--reference", str(index)]
+        assert main([*argv, *extra, "--json"]) == 0
+        summary = json.loads(capsys.readouterr().out)
+        assert summary["n"] == 19 and summary["translation_max"] < 1e-9, name
+    # The corrected log's numbers read as raw ones: 3, 10 and 17 pair, wrongly.
+    own = ["eval", "--estimate", str(tmp_path / "own.tum"), "--reference", str(index)]
+    assert main([*own, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["n"] == 2
+
+
+def test_map_and_eval_on_the_subsampled_intel_log(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The GMapping-corrected Intel log (910 scans, its times out of order in 4 places,
+    so the trajectory numbers the scans, and says so) against the benchmark index, paired
+    by gfs_scan."""
+    log = require_real("radish-gfs-corrected/intel-corrected.log.gz")
+    index = require_real("benchmark-scans-split/intel__intel-corrected__index.csv")
+    out = tmp_path / "intel"
+    assert main(["map", str(log), "--out", str(out), "--quiet"]) == 0
+    assert capsys.readouterr().err == (
+        "ndtgrid map: the log's times go back or repeat in 4 places, so trajectory.tum "
+        "numbers the scans (0, 1, ...) instead\n"
+    )
+    times, _ = read_tum(out / "trajectory.tum")
+    np.testing.assert_array_equal(times, np.arange(910.0))
+    est = ["eval", "--estimate", str(out / "trajectory.tum"), "--reference", str(index)]
+    assert main([*est, "--reference-time", "gfs_scan", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["n"] == 909
+    assert summary["translation_mean"] < 0.06 and summary["rotation_mean"] < 1.0
+
+
 def test_map_and_eval_on_the_intel_split(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -130,11 +130,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     e.add_argument(
         "--reference-time",
-        choices=["auto", "raw_scan", "ipc_ts"],
+        choices=["auto", "raw_scan", "gfs_scan", "ipc_ts"],
         default="auto",
-        help="index CSV column matched with the estimate's timestamps; auto: raw_scan when "
-        "every estimate timestamp is an integer (scan indices, as `ndtgrid map` writes for "
-        "logs without time), else ipc_ts",
+        help="index CSV column matched with the estimate's timestamps: raw_scan (the "
+        "full-rate log's scan number), gfs_scan (the corrected log's scan number) or "
+        "ipc_ts (time); auto: raw_scan when every estimate timestamp is an integer (scan "
+        "numbers, as `ndtgrid map` writes for logs without time, e.g. the benchmark "
+        "splits), else ipc_ts. A corrected log whose times are out of order is numbered "
+        "by scan too: pair it by gfs_scan",
     )
     e.add_argument(
         "--max-dt", type=float, default=0.05, help="largest time gap of a matched pose [s]"
@@ -216,8 +219,14 @@ def _map_into(
     if poses.shape[0] == 0:
         return None
     stamps = np.asarray(times)
-    if np.any(np.diff(stamps) <= 0):  # repeated or unordered stamps: fall back to indices
+    unordered = int(np.sum(np.diff(stamps) <= 0))
+    if unordered:  # repeated or unordered stamps: number the scans instead
         stamps = np.arange(len(times), dtype=np.float64)
+        print(
+            f"ndtgrid map: the log's times go back or repeat in {unordered} places, so "
+            "trajectory.tum numbers the scans (0, 1, ...) instead",
+            file=sys.stderr,
+        )
     write_tum(out / "trajectory.tum", stamps, poses)
     save_map(out / "map.ndtgrid", full)
     centres, _ = full.cells()
@@ -330,11 +339,15 @@ def run_eval(args: argparse.Namespace) -> int:
     times, poses = read_tum(args.estimate)
     if args.reference.endswith(".csv"):
         index = read_benchmark_index(args.reference)
+        columns = {
+            "raw_scan": index.raw_scan.astype(np.float64),
+            "gfs_scan": index.corrected_scan.astype(np.float64),
+            "ipc_ts": index.timestamp,
+        }
         column = args.reference_time
         if column == "auto":
             column = "raw_scan" if np.all(times == np.round(times)) else "ipc_ts"
-        ref_times = index.raw_scan.astype(np.float64) if column == "raw_scan" else index.timestamp
-        ref_poses = index.corrected
+        ref_times, ref_poses = columns[column], index.corrected
     else:
         ref_times, ref_poses = read_tum(args.reference)
     match = associate(times, ref_times, max_dt=args.max_dt)
