@@ -140,7 +140,8 @@ def test_map_and_eval_on_the_subsampled_intel_log(
     assert main(["map", str(log), "--out", str(out), "--quiet"]) == 0
     assert capsys.readouterr().err == (
         "ndtgrid map: the log's times go back or repeat in 4 places, so trajectory.tum "
-        "numbers the scans (0, 1, ...) instead\n"
+        "numbers the scans (0, 1, ...) instead (ndtgrid eval pairs them with an index CSV "
+        "by --reference-time raw_scan for a full-rate log, gfs_scan for a corrected one)\n"
     )
     times, _ = read_tum(out / "trajectory.tum")
     np.testing.assert_array_equal(times, np.arange(910.0))

@@ -224,7 +224,9 @@ def _map_into(
         stamps = np.arange(len(times), dtype=np.float64)
         print(
             f"ndtgrid map: the log's times go back or repeat in {unordered} places, so "
-            "trajectory.tum numbers the scans (0, 1, ...) instead",
+            "trajectory.tum numbers the scans (0, 1, ...) instead (ndtgrid eval pairs them "
+            "with an index CSV by --reference-time raw_scan for a full-rate log, gfs_scan "
+            "for a corrected one)",
             file=sys.stderr,
         )
     write_tum(out / "trajectory.tum", stamps, poses)
