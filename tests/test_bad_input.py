@@ -51,7 +51,8 @@ angles shorter than ranges      ValueError   angles: expected B values (one per 
 an angle NaN / inf              ValueError   angles: expected finite values, got NaN at index i
 ranges / angles 2-D or scalar   ValueError   ranges: expected a 1-D array, got shape (1, B)
 ranges complex / bool / str     TypeError    ranges: expected real numbers (float64), got dtype
-ranges = None / object array    TypeError    same, ``got dtype object``
+ranges = None / ragged lists    TypeError    ranges: expected an array-like of real numbers...
+ranges an object ndarray        TypeError    ranges: expected real numbers ..., got dtype object
 pose / odom of 2 values         ValueError   pose: expected 3 values [x, y, theta], got shape ..
 pose / odom with NaN            ValueError   pose: expected finite values, got NaN at index i
 a range beyond ±2**30 cells     ValueError   ranges: point i at (x, y) m is outside the grid's
@@ -144,7 +145,7 @@ CASES: list[tuple[str, Callable[[ndtgrid.NdtGrid], Any], type[Exception], str]] 
         "None",
         lambda g: g.insert(None, POSE),
         TypeError,
-        "points: expected real numbers (float64), got dtype object",
+        "points: expected an array-like of real numbers, got NoneType",
     ),
     (
         "ragged",
@@ -406,7 +407,7 @@ SCAN_CASES: list[tuple[str, Callable[[Callable[..., Any]], Any], type[Exception]
         "ranges None",
         lambda f: f(None, ANGLES),
         TypeError,
-        "ranges: expected real numbers (float64), got dtype object",
+        "ranges: expected an array-like of real numbers, got NoneType",
     ),
     (
         "ranges ragged",

@@ -63,23 +63,30 @@ fn real_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, P
     // An ndarray itself (not a subclass) is what `numpy.asarray` returns for
     // it: the common case skips the call (and `asarray` is looked up once).
     static ASARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
-    let arr = if obj.get_type().is(py.get_type::<PyUntypedArray>()) {
+    let given = obj.get_type().is(py.get_type::<PyUntypedArray>());
+    let arr = if given {
         Ok(obj.clone())
     } else {
         ASARRAY
             .import(py, "numpy", "asarray")
             .and_then(|asarray| asarray.call1((obj,)))
     };
-    let arr = arr.map_err(|_| {
+    let not_array_like = || {
         PyTypeError::new_err(format!(
             "{what}: expected an array-like of real numbers, got {}",
             type_name(obj)
         ))
-    })?;
+    };
+    let arr = arr.map_err(|_| not_array_like())?;
     let arr = arr.cast_into::<PyUntypedArray>().map_err(|_| {
         PyTypeError::new_err(format!("{what}: expected an array-like of real numbers"))
     })?;
     let dtype = arr.dtype();
+    // NumPy before 1.24 makes ragged nested lists an object array where later
+    // versions refuse them: the same error either way.
+    if !given && dtype.kind() == b'O' {
+        return Err(not_array_like());
+    }
     if !matches!(dtype.kind(), b'f' | b'i' | b'u') {
         return Err(PyTypeError::new_err(format!(
             "{what}: expected real numbers (float64), got dtype {}",
