@@ -14,6 +14,9 @@ macro_rules! stub_doc {
     };
 }
 
+#[macro_use]
+mod record;
+
 mod convert;
 mod errors;
 mod freespace;

@@ -6,6 +6,7 @@ use pyo3::types::{PyDict, PyType};
 
 use crate::convert::count;
 use crate::errors::to_py;
+use crate::record::reduce;
 
 #[pymethods]
 impl PyMapperOptions {
@@ -97,8 +98,7 @@ impl PyMapperOptions {
     fn __reduce__<'py>(
         slf: &Bound<'py, Self>,
     ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyDict>,))> {
-        let options = options_dict(slf.py(), &slf.get().core())?;
-        Ok((slf.get_type().getattr("_restore")?, (options,)))
+        reduce(slf, options_dict(slf.py(), &slf.get().core())?)
     }
 
     /// The options `__reduce__` took apart, checked as the constructor checks them.

@@ -12,6 +12,7 @@ use pyo3::types::{PyDict, PyType};
 use crate::convert::{count, level_mask, level_tuple, pose, vec3, vector};
 use crate::errors::{poisoned, to_py};
 use crate::grid::PyNdtGrid;
+use crate::record::reduce;
 
 #[doc = stub_doc!("OdometryLoop")]
 #[pyclass(name = "OdometryLoop", module = "ndtgrid._core", frozen)]
@@ -19,43 +20,30 @@ pub struct PyOdometry {
     inner: Mutex<Odometry>,
 }
 
-#[doc = stub_doc!("OdometryStep")]
-#[pyclass(name = "OdometryStep", module = "ndtgrid._core", frozen)]
-#[derive(Clone)]
-pub struct PyStep {
-    pose: [f64; 3],
-    prediction: [f64; 3],
-    #[pyo3(get)]
-    matched: bool,
-    #[pyo3(get)]
-    accepted: bool,
-    #[pyo3(get)]
-    multi_start: bool,
-    #[pyo3(get)]
-    inserted: bool,
-    #[pyo3(get)]
-    converged: bool,
-    #[pyo3(get)]
-    iterations: u32,
-    #[pyo3(get)]
-    num_matched: usize,
-    #[pyo3(get)]
-    num_points: usize,
+record! {
+    #[doc = stub_doc!("OdometryStep")]
+    #[pyclass(name = "OdometryStep", module = "ndtgrid._core", frozen)]
+    pub struct PyStep(StepState) {
+        pose: [f64; 3],
+        prediction: [f64; 3],
+        #[pyo3(get)]
+        matched: bool,
+        #[pyo3(get)]
+        accepted: bool,
+        #[pyo3(get)]
+        multi_start: bool,
+        #[pyo3(get)]
+        inserted: bool,
+        #[pyo3(get)]
+        converged: bool,
+        #[pyo3(get)]
+        iterations: u32,
+        #[pyo3(get)]
+        num_matched: usize,
+        #[pyo3(get)]
+        num_points: usize,
+    }
 }
-
-/// Every field of a [`PyStep`], in declaration order: what pickle keeps.
-type StepState = (
-    [f64; 3],
-    [f64; 3],
-    bool,
-    bool,
-    bool,
-    bool,
-    bool,
-    u32,
-    usize,
-    usize,
-);
 
 impl From<StepOutcome> for PyStep {
     fn from(s: StepOutcome) -> Self {
@@ -90,49 +78,13 @@ impl PyStep {
 
     #[doc = stub_doc!("OdometryStep.__reduce__")]
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (StepState,))> {
-        let s = slf.get().clone();
-        let state = (
-            s.pose,
-            s.prediction,
-            s.matched,
-            s.accepted,
-            s.multi_start,
-            s.inserted,
-            s.converged,
-            s.iterations,
-            s.num_matched,
-            s.num_points,
-        );
-        Ok((slf.get_type().getattr("_restore")?, (state,)))
+        reduce(slf, slf.get().state())
     }
 
     /// The step `__reduce__` took apart.
     #[classmethod]
     fn _restore(_cls: &Bound<'_, PyType>, state: StepState) -> Self {
-        let (
-            pose,
-            prediction,
-            matched,
-            accepted,
-            multi_start,
-            inserted,
-            converged,
-            iterations,
-            num_matched,
-            num_points,
-        ) = state;
-        Self {
-            pose,
-            prediction,
-            matched,
-            accepted,
-            multi_start,
-            inserted,
-            converged,
-            iterations,
-            num_matched,
-            num_points,
-        }
+        Self::from_state(state)
     }
 
     fn __repr__(&self) -> String {

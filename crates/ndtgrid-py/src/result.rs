@@ -6,36 +6,26 @@ use pyo3::prelude::*;
 use pyo3::types::PyType;
 
 use crate::convert::{mat3, rows, vec3};
+use crate::record::reduce;
 
-#[doc = stub_doc!("MatchResult")]
-#[pyclass(name = "MatchResult", module = "ndtgrid._core", frozen)]
-#[derive(Clone)]
-pub struct PyMatchResult {
-    pose: [f64; 3],
-    #[pyo3(get)]
-    converged: bool,
-    #[pyo3(get)]
-    iterations: u32,
-    #[pyo3(get)]
-    score: f64,
-    #[pyo3(get)]
-    num_matched: usize,
-    hessian: [[f64; 3]; 3],
-    covariance: [[f64; 3]; 3],
-    unconstrained: Vec<[f64; 3]>,
+record! {
+    #[doc = stub_doc!("MatchResult")]
+    #[pyclass(name = "MatchResult", module = "ndtgrid._core", frozen)]
+    pub struct PyMatchResult(State) {
+        pose: [f64; 3],
+        #[pyo3(get)]
+        converged: bool,
+        #[pyo3(get)]
+        iterations: u32,
+        #[pyo3(get)]
+        score: f64,
+        #[pyo3(get)]
+        num_matched: usize,
+        hessian: [[f64; 3]; 3],
+        covariance: [[f64; 3]; 3],
+        unconstrained: Vec<[f64; 3]>,
+    }
 }
-
-/// Every field of a [`PyMatchResult`], in declaration order: what pickle keeps.
-type State = (
-    [f64; 3],
-    bool,
-    u32,
-    f64,
-    usize,
-    [[f64; 3]; 3],
-    [[f64; 3]; 3],
-    Vec<[f64; 3]>,
-);
 
 impl From<MatchResult> for PyMatchResult {
     fn from(r: MatchResult) -> Self {
@@ -87,35 +77,13 @@ impl PyMatchResult {
 
     #[doc = stub_doc!("MatchResult.__reduce__")]
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (State,))> {
-        let r = slf.get().clone();
-        let state = (
-            r.pose,
-            r.converged,
-            r.iterations,
-            r.score,
-            r.num_matched,
-            r.hessian,
-            r.covariance,
-            r.unconstrained,
-        );
-        Ok((slf.get_type().getattr("_restore")?, (state,)))
+        reduce(slf, slf.get().state())
     }
 
     /// The result `__reduce__` took apart.
     #[classmethod]
     fn _restore(_cls: &Bound<'_, PyType>, state: State) -> Self {
-        let (pose, converged, iterations, score, num_matched, hessian, covariance, unconstrained) =
-            state;
-        Self {
-            pose,
-            converged,
-            iterations,
-            score,
-            num_matched,
-            hessian,
-            covariance,
-            unconstrained,
-        }
+        Self::from_state(state)
     }
 
     fn __repr__(&self) -> String {

@@ -6,14 +6,17 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyType};
 
-#[doc = stub_doc!("SmallObject")]
-#[pyclass(name = "SmallObject", module = "ndtgrid._core", frozen)]
-#[derive(Clone)]
-pub struct PySmallObject {
-    center: [f64; 2],
-    cells: Vec<f64>,
-    #[pyo3(get)]
-    num_points: u64,
+use crate::record::reduce;
+
+record! {
+    #[doc = stub_doc!("SmallObject")]
+    #[pyclass(name = "SmallObject", module = "ndtgrid._core", frozen)]
+    pub struct PySmallObject(ObjectState) {
+        center: [f64; 2],
+        cells: Vec<f64>,
+        #[pyo3(get)]
+        num_points: u64,
+    }
 }
 
 impl PySmallObject {
@@ -50,24 +53,14 @@ impl PySmallObject {
     }
 
     #[doc = stub_doc!("SmallObject.__reduce__")]
-    #[allow(clippy::type_complexity)]
-    fn __reduce__<'py>(
-        slf: &Bound<'py, Self>,
-    ) -> PyResult<(Bound<'py, PyAny>, (([f64; 2], Vec<f64>, u64),))> {
-        let o = slf.get().clone();
-        let state = (o.center, o.cells, o.num_points);
-        Ok((slf.get_type().getattr("_restore")?, (state,)))
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (ObjectState,))> {
+        reduce(slf, slf.get().state())
     }
 
     /// The object `__reduce__` took apart.
     #[classmethod]
-    fn _restore(_cls: &Bound<'_, PyType>, state: ([f64; 2], Vec<f64>, u64)) -> Self {
-        let (center, cells, num_points) = state;
-        Self {
-            center,
-            cells,
-            num_points,
-        }
+    fn _restore(_cls: &Bound<'_, PyType>, state: ObjectState) -> Self {
+        Self::from_state(state)
     }
 
     fn __repr__(&self) -> String {
@@ -143,8 +136,7 @@ impl PyRemovalCounts {
 
     #[doc = stub_doc!("RemovalCounts.__reduce__")]
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, ([u64; 9],))> {
-        let counts = slf.get().inner.entries().map(|(_, v)| v);
-        Ok((slf.get_type().getattr("_restore")?, (counts,)))
+        reduce(slf, slf.get().inner.entries().map(|(_, v)| v))
     }
 
     /// The counts `__reduce__` took apart.
