@@ -11,6 +11,7 @@ import pytest
 import ndtgrid
 from ndtgrid._core import FreeSpace
 from ndtgrid.export import (
+    OccupancyImage,
     load_map,
     occupancy_image,
     read_ros_map,
@@ -126,6 +127,37 @@ def test_png_is_written(tmp_path: Path) -> None:
     write_png(tmp_path / "m.png", image, trajectory=[[0, 0, 0], [0.5, -0.5, 2.5]], title="room")
     data = (tmp_path / "m.png").read_bytes()
     assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 5000
+
+
+def test_png_of_a_large_map_draws_it_reduced_with_its_thin_walls(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An image with more cells than the figure has pixels is drawn in blocks (a large
+    log's took gigabytes drawn whole): no larger than the axes, a block black where it
+    holds an occupied cell, else white where it holds a free one, else grey."""
+    axes = pytest.importorskip("matplotlib.axes")
+    cells = np.full((3000, 4001), -1, np.int8)  # unknown
+    cells[:, :2000] = 0  # free on the left
+    cells[1501, :] = 100  # a wall one cell thick across the whole image
+    drawn: list[np.ndarray] = []
+    imshow = axes.Axes.imshow
+
+    def spy(self: object, grey: np.ndarray, *args: object, **kwargs: object) -> object:
+        drawn.append(np.asarray(grey))
+        return imshow(self, grey, *args, **kwargs)
+
+    monkeypatch.setattr(axes.Axes, "imshow", spy)
+    image = OccupancyImage(cells=cells, origin=np.array([-1.0, 2.0]), resolution=0.05)
+    write_png(tmp_path / "big.png", image)
+    (grey,) = drawn
+    factor = math.ceil(4001 / grey.shape[1])
+    assert factor >= 3 and grey.shape == (math.ceil(3000 / factor), math.ceil(4001 / factor))
+    wall = 1501 // factor
+    assert np.all(grey[wall] == 0.0)  # the wall in every block column
+    rows = np.delete(np.arange(grey.shape[0]), wall)
+    free_blocks = 2000 // factor  # blocks wholly left of the free edge
+    assert np.all(grey[np.ix_(rows, np.arange(free_blocks))] == 1.0)
+    assert np.all(grey[np.ix_(rows, np.arange(free_blocks + 1, grey.shape[1]))] == 0.8)
 
 
 def test_map_file_loads_back_identical(tmp_path: Path) -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 from typing import Any
 
@@ -53,12 +54,18 @@ def write_png(
         Without matplotlib (names ``pip install ndtgrid[plot]``).
     """
     plt = _pyplot()
-    grey = np.select([image.cells == 100, image.cells == 0], [0.0, 1.0], default=0.8)
     h, w = image.cells.shape
-    x0, y0 = (float(v) for v in image.origin)
-    extent = (x0, x0 + w * image.resolution, y0, y0 + h * image.resolution)
     fig, ax = plt.subplots(figsize=(8, 8 * h / max(w, 1) + 0.5))
     try:
+        # Pixels of the axes in the file: an image with more cells is first reduced to
+        # them (a large log's image, drawn whole, took gigabytes and dropped walls).
+        box = ax.get_position()
+        pixels = (box.height * fig.get_figheight() * dpi, box.width * fig.get_figwidth() * dpi)
+        factor = max(1, math.ceil(max(h / pixels[0], w / pixels[1])))
+        grey = _reduced(image.cells, factor)
+        x0, y0 = (float(v) for v in image.origin)
+        side = factor * image.resolution
+        extent = (x0, x0 + grey.shape[1] * side, y0, y0 + grey.shape[0] * side)
         ax.imshow(
             grey,
             cmap="gray",
@@ -80,3 +87,18 @@ def write_png(
         fig.savefig(os.fspath(path), dpi=dpi, bbox_inches="tight")
     finally:
         plt.close(fig)
+
+
+def _reduced(cells: npt.NDArray[np.int8], factor: int) -> npt.NDArray[np.float64]:
+    """The grey levels of ``cells`` (occupancy values: 100 occupied, 0 free, -1 unknown)
+    in blocks of ``factor`` x ``factor`` cells: black where a block holds an occupied
+    cell, else white where it holds a free one, else grey (so a wall one cell thick is
+    still drawn). Blocks past the image's edge are unknown."""
+    rank = np.where(cells == 100, np.int8(2), (cells == 0).astype(np.int8))
+    if factor > 1:
+        h, w = rank.shape
+        padded = np.zeros((-(-h // factor) * factor, -(-w // factor) * factor), np.int8)
+        padded[:h, :w] = rank
+        rank = padded.reshape(padded.shape[0] // factor, factor, -1, factor).max(axis=(1, 3))
+    grey: npt.NDArray[np.float64] = np.array([0.8, 1.0, 0.0])[rank]
+    return grey
