@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 import os
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import pytest
@@ -54,12 +54,17 @@ ROOM = scan((0.0, 0.0, 0.0), beams=181)
 ANGLES = np.linspace(-1.5, 1.5, 181)
 
 
+def float_width(dtype: np.dtype[Any]) -> Literal[32, 64]:
+    """The bits of a float32 or float64 dtype, as hypothesis's ``floats`` takes them."""
+    return 32 if dtype.itemsize == 4 else 64
+
+
 def elements(dtype: np.dtype[Any]) -> st.SearchStrategy[Any]:
     if dtype.kind == "O":
         return OBJECTS
     if dtype.kind == "f":
         # Mostly moderate values (so the success path is exercised), sometimes anything.
-        width = 8 * dtype.itemsize
+        width = float_width(dtype)
         return st.one_of(
             st.floats(-5.0, 5.0, width=width),
             st.floats(-5.0, 5.0, width=width),
@@ -87,8 +92,11 @@ def arrays(
     if kind >= 10 and good is not None:
         dtype = draw(st.sampled_from(REAL))
         dims = tuple(draw(st.integers(0, 12)) if d < 0 else d for d in good)
-        width = 8 * dtype.itemsize
-        values = st.floats(-5.0, 5.0, width=width) if dtype.kind == "f" else st.integers(-5, 5)
+        values = (
+            st.floats(-5.0, 5.0, width=float_width(dtype))
+            if dtype.kind == "f"
+            else st.integers(-5, 5)
+        )
         arr = draw(hnp.arrays(dtype, dims, elements=values))
         if dtype.kind == "f" and arr.size and draw(st.integers(0, 3)) == 0:
             with np.errstate(over="ignore"):  # 1e300 into float32 is inf: fine
