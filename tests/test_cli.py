@@ -227,6 +227,26 @@ def test_bad_files_and_values_are_one_line_errors(
     assert not out.exists()
 
 
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["map", "x.log", "--max-scans", "-3"], "argument --max-scans: expected a whole number"),
+        (["map", "x.log", "--max-scans", "2.5"], "argument --max-scans: expected a whole number"),
+        (["eval", "--estimate", "a", "--reference", "b", "--max-dt", "nan"], "argument --max-dt"),
+        (["eval", "--estimate", "a", "--reference", "b", "--max-dt", "-1"], "expected seconds"),
+    ],
+)
+def test_bad_counts_and_times_are_usage_errors(
+    argv: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A negative or fractional scan count, or a time gap that is negative or not a
+    number: argparse's usage error (exit status 2), before any file is read."""
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    assert info.value.code == 2
+    assert message in capsys.readouterr().err
+
+
 def test_readings_beyond_max_range_are_dropped() -> None:
     from ndtgrid.cli import usable_ranges
     from ndtgrid.io import Scan

@@ -42,6 +42,28 @@ if TYPE_CHECKING:
 T = TypeVar("T")
 
 
+def _whole(text: str) -> int:
+    """An argument that is a whole number, 0 or more."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}")
+    return value
+
+
+def _seconds(text: str) -> float:
+    """An argument that is a finite number of seconds, 0 or more."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"expected seconds >= 0, got {text!r}")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``ndtgrid`` command.
 
@@ -78,7 +100,7 @@ def build_parser() -> argparse.ArgumentParser:
     m.add_argument(
         "--resolution", type=float, default=0.05, help="pixel size of map.pgm/png [m] (0.05)"
     )
-    m.add_argument("--max-scans", type=int, default=None, help="stop after this many scans")
+    m.add_argument("--max-scans", type=_whole, default=None, help="stop after this many scans")
     m.add_argument("--quiet", action="store_true", help="no progress bar")
     d = sub.add_parser(
         "demo",
@@ -140,7 +162,7 @@ def build_parser() -> argparse.ArgumentParser:
         "by scan too: pair it by gfs_scan",
     )
     e.add_argument(
-        "--max-dt", type=float, default=0.05, help="largest time gap of a matched pose [s]"
+        "--max-dt", type=_seconds, default=0.05, help="largest time gap of a matched pose [s]"
     )
     e.add_argument("--json", action="store_true", help="print the summary as JSON")
     return parser
