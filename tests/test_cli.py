@@ -234,6 +234,8 @@ def test_bad_files_and_values_are_one_line_errors(
         (["map", "x.log", "--max-scans", "2.5"], "argument --max-scans: expected a whole number"),
         (["eval", "--estimate", "a", "--reference", "b", "--max-dt", "nan"], "argument --max-dt"),
         (["eval", "--estimate", "a", "--reference", "b", "--max-dt", "-1"], "expected seconds"),
+        (["demo", "--seed", "-5"], "argument --seed: expected a whole number >= 0, got '-5'"),
+        (["bench", "--seed", "x"], "argument --seed: expected a whole number >= 0, got 'x'"),
     ],
 )
 def test_bad_counts_and_times_are_usage_errors(

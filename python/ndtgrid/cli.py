@@ -109,7 +109,7 @@ def build_parser() -> argparse.ArgumentParser:
         "map it like 'ndtgrid map' and report the error against the truth.",
     )
     d.add_argument("--out", default="demo-out", help="output directory (default: demo-out)")
-    d.add_argument("--seed", type=int, default=0, help="simulation seed (0)")
+    d.add_argument("--seed", type=_whole, default=0, help="simulation seed (0)")
     d.add_argument("--quiet", action="store_true", help="no progress bar")
     b = sub.add_parser(
         "bench",
@@ -128,7 +128,7 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"simulated scans, at least {bench.MIN_SCANS} (default: every pose of the "
         "simulated tour; a run refuses more, naming how many it has)",
     )
-    b.add_argument("--seed", type=int, default=0, help="simulation seed (0)")
+    b.add_argument("--seed", type=_whole, default=0, help="simulation seed (0)")
     b.add_argument(
         "--repeats",
         type=int,
