@@ -162,6 +162,10 @@ def test_png_of_a_large_map_draws_it_reduced_with_its_thin_walls(
 
 def test_map_file_loads_back_identical(tmp_path: Path) -> None:
     grid, _ = room_map(0.05)
+    with pytest.raises(TypeError) as info:
+        save_map(tmp_path / "map.ndtgrid", grid.cells())  # type: ignore[arg-type]
+    assert str(info.value) == "grid: expected an NdtGrid or a Mapper, got tuple"
+    assert not (tmp_path / "map.ndtgrid").exists()
     save_map(tmp_path / "map.ndtgrid", grid)
     assert (tmp_path / "map.ndtgrid").read_bytes() == grid.to_bytes()
     assert (tmp_path / "map.ndtgrid").read_bytes()[:8] == MAGIC

@@ -46,10 +46,15 @@ def save_map(path: str | os.PathLike[str], grid: NdtGrid | Mapper) -> None:
 
     Raises
     ------
+    TypeError
+        If ``grid`` is neither an :class:`~ndtgrid.NdtGrid` nor a
+        :class:`~ndtgrid.Mapper` (nothing is written).
     OSError
         If the file cannot be written (the message names it; an existing file is left
         as it was).
     """
+    if not isinstance(grid, (NdtGrid, Mapper)):
+        raise TypeError(f"grid: expected an NdtGrid or a Mapper, got {type(grid).__name__}")
     grid.save(path)
 
 
