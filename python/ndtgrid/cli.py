@@ -363,15 +363,12 @@ def run_eval(args: argparse.Namespace) -> int:
     times, poses = read_tum(args.estimate)
     if args.reference.endswith(".csv"):
         index = read_benchmark_index(args.reference)
-        columns = {
-            "raw_scan": index.raw_scan.astype(np.float64),
-            "gfs_scan": index.corrected_scan.astype(np.float64),
-            "ipc_ts": index.timestamp,
-        }
         column = args.reference_time
         if column == "auto":
             column = "raw_scan" if np.all(times == np.round(times)) else "ipc_ts"
-        ref_times, ref_poses = columns[column], index.corrected
+        columns = {"raw_scan": index.raw_scan, "gfs_scan": index.corrected_scan}
+        ref_times = columns.get(column, index.timestamp).astype(np.float64)
+        ref_poses = index.corrected
     else:
         ref_times, ref_poses = read_tum(args.reference)
     match = associate(times, ref_times, max_dt=args.max_dt)
