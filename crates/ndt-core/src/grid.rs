@@ -372,7 +372,7 @@ impl NdtGrid {
             .map(|lv| lv.cells().heap_bytes())
             .sum();
         let prepared: usize = self.lock_prepared().iter().map(|d| d.heap_bytes()).sum();
-        sums + self.pyramid.occupied().heap_bytes() + prepared
+        sums + self.pyramid.occupied().heap_bytes() + self.pyramid.marks_heap_bytes() + prepared
     }
 
     /// Keys of every occupied cell, in no particular order.

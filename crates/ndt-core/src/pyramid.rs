@@ -57,6 +57,67 @@ pub struct Pyramid {
     /// scans, and each new vector took the allocator's lock, which the
     /// mapper's helper thread may hold (BENCHMARK.md, "Speed", session 27).
     spare: Vec<Vec<CellKey>>,
+    /// Per level, per index of a cell's value: the number of the last
+    /// [`Pyramid::refresh_parents`] that met the cell ([`Stamps`]).
+    stamps: Stamps,
+    /// Per changed parent of one level: the index of its value, or
+    /// [`NEW_PARENT`] (reused between updates).
+    parent_slots: Vec<u32>,
+    /// The cells an insert added to the fine level (reused between updates).
+    fresh: Vec<CellKey>,
+}
+
+/// A parent cell that had no value when it was met.
+const NEW_PARENT: u32 = u32::MAX;
+
+/// Which coarse cells one [`Pyramid::refresh_parents`] has met already: a
+/// number per cell, compared with the call's own, instead of a set of keys
+/// (one look-up finds the cell's value and its mark, and the same index then
+/// takes its new sums without a second look-up).
+#[derive(Debug, Clone, Default)]
+struct Stamps {
+    call: u32,
+    levels: Vec<Vec<u32>>,
+}
+
+impl Stamps {
+    /// Starts a new call: no cell is met yet.
+    fn next_call(&mut self, levels: usize) {
+        self.levels.resize_with(levels, Vec::new);
+        self.call = self.call.wrapping_add(1);
+        if self.call == 0 {
+            // After 2³² calls: old marks could equal new numbers.
+            for l in &mut self.levels {
+                l.fill(0);
+            }
+            self.call = 1;
+        }
+    }
+
+    /// Marks the cell of value index `index` on level `level`; `true` when
+    /// this call had not met it. `len`: the level's number of values.
+    #[inline]
+    fn first_meeting(&mut self, level: usize, index: u32, len: usize) -> bool {
+        let Some(marks) = self.levels.get_mut(level) else {
+            return true;
+        };
+        if marks.len() < len {
+            marks.resize(len, 0);
+        }
+        match marks.get_mut(index as usize) {
+            Some(m) if *m == self.call => false,
+            Some(m) => {
+                *m = self.call;
+                true
+            }
+            None => true,
+        }
+    }
+
+    /// Bytes on the heap.
+    fn heap_bytes(&self) -> usize {
+        self.levels.iter().map(|l| l.capacity() * 4).sum()
+    }
 }
 
 /// The key of the level-`level` cell covering fine cell `key`: an arithmetic
@@ -84,6 +145,9 @@ impl Pyramid {
             occupied: Occupancy::default(),
             seen: KeyScratch::default(),
             spare: Vec::with_capacity(SPARE_KEYS),
+            stamps: Stamps::default(),
+            parent_slots: Vec::new(),
+            fresh: Vec::new(),
         }
     }
 
@@ -112,6 +176,14 @@ impl Pyramid {
     /// more), `None` when the fine level is empty.
     pub fn bounds(&self) -> Option<KeyBounds> {
         self.bounds
+    }
+
+    /// Bytes on the heap of the update's marks of the coarse cells (one
+    /// word a cell; the levels' own bytes are [`CellTable::heap_bytes`]).
+    pub fn marks_heap_bytes(&self) -> usize {
+        self.stamps.heap_bytes()
+            + self.parent_slots.capacity() * 4
+            + self.fresh.capacity() * std::mem::size_of::<CellKey>()
     }
 
     /// The occupied fine cells.
@@ -162,13 +234,23 @@ impl Pyramid {
     /// for [`Pyramid::refresh`]. Returns the fine cells that changed.
     pub(crate) fn add_fine(&mut self, staged: &[(CellKey, Vector2<f64>)]) -> Vec<CellKey> {
         let mut touched = self.keys(staged.len());
+        self.stamps.next_call(self.levels.len());
+        let stamps = &mut self.stamps;
         let fine = &mut self.levels[0];
-        let seen = self.seen.take();
+        // Cells new to the level take the values' indices from here on (no
+        // removal here: the indices hold for the whole call).
+        let before = fine.cells.len();
+        let fresh = &mut self.fresh;
+        fresh.clear();
         let mut run: Option<(CellKey, CellStats)> = None;
         let mut flush = |key: CellKey, stats: &CellStats| {
-            fine.cells.get_or_default(key).merge(stats);
-            if seen.insert(key) {
+            let (i, cell) = fine.cells.index_or_default(key);
+            cell.merge(stats);
+            if stamps.first_meeting(0, i, fine.cells.len()) {
                 touched.push(key);
+                if i as usize >= before {
+                    fresh.push(key);
+                }
             }
         };
         for &(key, w) in staged {
@@ -188,8 +270,9 @@ impl Pyramid {
         if let Some((k, stats)) = run {
             flush(k, &stats);
         }
-        self.occupied.insert(&touched);
-        if let Some(added) = KeyBounds::of_keys(touched.iter().copied()) {
+        // Only new cells change the occupancy, or can lie beyond the bounds.
+        self.occupied.insert(&self.fresh);
+        if let Some(added) = KeyBounds::of_keys(self.fresh.iter().copied()) {
             self.bounds = Some(match self.bounds {
                 Some(b) => b.including(added.min).including(added.max),
                 None => added,
@@ -218,37 +301,59 @@ impl Pyramid {
     fn refresh_parents(&mut self, fine: Vec<CellKey>) -> Vec<Vec<CellKey>> {
         let mut touched_all: Vec<Vec<CellKey>> = Vec::with_capacity(self.levels.len());
         touched_all.push(fine);
+        self.stamps.next_call(self.levels.len());
+        let mut slots = std::mem::take(&mut self.parent_slots);
         for l in 1..self.levels.len() {
             let below = touched_all[l - 1].len();
             let mut changed = self.keys(below);
-            let parents = self.seen.take();
-            // Changed children come in runs under one parent: the last
-            // parent is not looked up again.
-            let mut last = None;
-            for &child in &touched_all[l - 1] {
-                let parent = coarse_key(child, 1);
-                if last != Some(parent) && parents.insert(parent) {
-                    changed.push(parent);
+            slots.clear();
+            // Parents that have no cell yet are kept apart by key.
+            let new_parents = self.seen.take();
+            let (lower_levels, upper_levels) = self.levels.split_at_mut(l);
+            let (lower, upper) = (&lower_levels[l - 1], &mut upper_levels[0]);
+            {
+                let len = upper.cells.len();
+                let mut existing = upper.cells.cursor();
+                // Changed children come in runs under one parent: the last
+                // parent is not looked up again.
+                let mut last = None;
+                for &child in &touched_all[l - 1] {
+                    let parent = coarse_key(child, 1);
+                    if last == Some(parent) {
+                        continue;
+                    }
+                    last = Some(parent);
+                    let first = match existing.index(parent) {
+                        Some(i) => self.stamps.first_meeting(l, i, len).then_some(i),
+                        None => new_parents.insert(parent).then_some(NEW_PARENT),
+                    };
+                    if let Some(i) = first {
+                        changed.push(parent);
+                        slots.push(i);
+                    }
                 }
-                last = Some(parent);
             }
-            let (below, above) = self.levels.split_at_mut(l);
-            let (lower, upper) = (&below[l - 1], &mut above[0]);
             // The 4 children of a parent share a tile: one tile look-up at most.
             let mut children = lower.cells.cursor();
             let none = CellStats::default();
-            for &parent in &changed {
+            // The values' indices hold until a removal moves one.
+            let mut indices_hold = true;
+            for (&parent, &i) in changed.iter().zip(&slots) {
                 // Children's sums are about their own centres, ±½ a child
                 // cell from the parent's (crate::gather).
                 let sum = gather::quad(&children.quad(parent, &none), lower.cell_size);
                 if sum.count == 0 {
                     upper.cells.remove(parent);
+                    indices_hold = false;
+                } else if i != NEW_PARENT && indices_hold {
+                    upper.cells.set_at(i, sum);
                 } else {
                     upper.cells.insert(parent, sum);
                 }
             }
             touched_all.push(changed);
         }
+        self.parent_slots = slots;
         touched_all
     }
 }
@@ -344,5 +449,37 @@ mod tests {
         }
         reused.give_back((0..3 * SPARE_KEYS).map(|_| vec![CellKey { ix: 0, iy: 0 }]));
         assert_eq!(reused.spare.len(), SPARE_KEYS);
+    }
+
+    /// An update's marks of met cells start again at 1 when their number
+    /// wraps (after 2³² updates): a mark left by an update before the wrap
+    /// does not hide a cell from one after it. Started 3 updates before the
+    /// wrap, a pyramid returns the keys and holds the sums of one started
+    /// at 0, through inserts and removals of the same cells.
+    #[test]
+    fn marks_survive_the_wrap_of_their_number() {
+        let (mut wrapped, mut plain) = (Pyramid::new(0.02, 4), Pyramid::new(0.02, 4));
+        wrapped.stamps.call = u32::MAX - 3;
+        let mut rng = StdRng::seed_from_u64(5);
+        for round in 0..8 {
+            let staged: Vec<(CellKey, Vector2<f64>)> = (0..200)
+                .map(|_| {
+                    let w = Vector2::new(rng.random_range(-0.3..0.3), rng.random_range(-0.3..0.3));
+                    (CellKey::of(w, 50.0).unwrap(), w)
+                })
+                .collect();
+            assert_eq!(wrapped.add(&staged), plain.add(&staged), "round {round}");
+            let removed: Vec<CellKey> = staged.iter().step_by(4).map(|(k, _)| *k).collect();
+            assert_eq!(
+                wrapped.remove(&removed),
+                plain.remove(&removed),
+                "round {round}"
+            );
+        }
+        assert!(wrapped.stamps.call < 100, "the number wrapped");
+        for l in 0..4 {
+            let (a, b) = (wrapped.level(l).unwrap(), plain.level(l).unwrap());
+            assert_eq!(a.cells(), b.cells(), "level {l}");
+        }
     }
 }

@@ -199,6 +199,35 @@ impl<T> CellTable<T> {
         &mut self.values[i]
     }
 
+    /// Sets the value at index `index` of the values (as
+    /// [`Cursor::index`] gave it, with no insert or removal since): no
+    /// look-up. An index out of range changes nothing.
+    #[inline]
+    pub fn set_at(&mut self, index: u32, value: T) {
+        if let Some(v) = self.values.get_mut(index as usize) {
+            *v = value;
+        }
+    }
+
+    /// The index of `key`'s value among the values (see [`Cursor::index`])
+    /// and the value, set to `T::default()` first when it has none (as
+    /// [`CellTable::get_or_default`]).
+    #[inline]
+    pub fn index_or_default(&mut self, key: CellKey) -> (u32, &mut T)
+    where
+        T: Default,
+    {
+        let (t, slot) = self.tile_of(key);
+        let i = match self.slots[t as usize][slot] {
+            EMPTY => {
+                self.push(t, slot, key, T::default());
+                self.values.len() - 1
+            }
+            i => i as usize,
+        };
+        (i as u32, &mut self.values[i])
+    }
+
     /// Removes every value (keeping the capacity).
     pub fn clear(&mut self) {
         self.tiles.clear();
@@ -508,6 +537,18 @@ impl<'a, T> Cursor<'a, T> {
             self.in_tile(slots, slot + row, none),
             self.in_tile(slots, slot + row + 1, none),
         ]
+    }
+
+    /// The index of `key`'s value among the table's values (stable until
+    /// the next insert of a new key or removal), if it has one.
+    #[inline(always)]
+    pub fn index(&mut self, key: CellKey) -> Option<u32> {
+        let (tile, slot) = split(key);
+        let slots = self.tile_slots(tile)?;
+        match slots.get(slot).copied() {
+            None | Some(EMPTY) => None,
+            Some(i) => Some(i),
+        }
     }
 
     /// The hashed look-up of a tile not remembered (kept out of line, so
