@@ -249,31 +249,36 @@ impl<M: WordMemo> CellMaskReader<'_, M> {
     }
 
     /// The members of the 3 × 3 block of cells around `key` as 9 bits, bit
-    /// `3 · (dy + 1) + (dx + 1)` for the cell at offset `(dx, dy)`: three
-    /// bits of one word per row, or of two where the row crosses a block
-    /// border.
+    /// `3 · (dy + 1) + (dx + 1)` for the cell at offset `(dx, dy)`. The
+    /// block lies in 1, 2 or 4 words, each read once; a row is three bits of
+    /// its word, or of the 16 bits of its two words side by side where it
+    /// crosses a block border.
     #[inline]
     pub fn block3(&mut self, key: CellKey) -> u16 {
-        let x0 = key.ix - 1;
+        let (x0, y0) = (key.ix - 1, key.iy - 1);
         let (left, right) = (x0 >> BLOCK_BITS, (x0 + 2) >> BLOCK_BITS);
+        let (low, high) = (y0 >> BLOCK_BITS, (y0 + 2) >> BLOCK_BITS);
+        let mut pair = |by: i32| {
+            let w = self.word((left, by));
+            (
+                w,
+                if right == left {
+                    w
+                } else {
+                    self.word((right, by))
+                },
+            )
+        };
+        let below = pair(low);
+        let above = if high == low { below } else { pair(high) };
+        let shift = x0 & MASK;
         let mut bits = 0u16;
         for r in 0..3 {
-            let y = key.iy + r - 1;
-            let (by, row) = (y >> BLOCK_BITS, (y & MASK) << BLOCK_BITS);
-            let w = self.word((left, by));
-            let three = if left == right {
-                (w >> (row | (x0 & MASK))) & 0b111
-            } else {
-                let w2 = self.word((right, by));
-                let mut three = 0;
-                for c in 0..3 {
-                    let x = x0 + c;
-                    let word = if x >> BLOCK_BITS == left { w } else { w2 };
-                    three |= ((word >> (row | (x & MASK))) & 1) << c;
-                }
-                three
-            };
-            bits |= (three as u16) << (3 * r);
+            let y = y0 + r;
+            let (wl, wr) = if y >> BLOCK_BITS == low { below } else { above };
+            let row = (y & MASK) << BLOCK_BITS;
+            let both = (wl >> row & 0xff) | (wr >> row & 0xff) << 8;
+            bits |= ((both >> shift & 0b111) as u16) << (3 * r);
         }
         bits
     }
