@@ -239,24 +239,20 @@ impl NdtGrid {
         pose: Pose2,
         spare: StagedScan,
     ) -> Result<StagedScan> {
-        check_values(points, pose)?;
-        let sin_cos = pose.theta.sin_cos();
+        check_finite("pose", &pose.to_array())?;
+        let (s, c) = pose.theta.sin_cos();
         let inv = self.inv_cell_size;
         // One pass without an exit per point (eq. 2, then the cell): whether
-        // every cell exists is checked once at the end, and only a scan that
-        // fails is searched for its first point beyond the lattice.
-        let mut all = true;
+        // every cell exists is checked once at the end. A non-finite point
+        // has no cell, so only a scan that fails is searched for one (the
+        // errors of `check_values`, in its order) and then for its first
+        // point beyond the lattice.
         let mut staged = spare.points;
         staged.clear();
-        staged.extend(points.iter().map(|p| {
-            let w = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
-            let (key, ok) = CellKey::of_flagged(w, inv);
-            all &= ok;
-            (key, w)
-        }));
-        if all {
+        if crate::staging::stage_points(points, [s, c, pose.x, pose.y, inv], &mut staged) {
             return Ok(StagedScan { points: staged });
         }
+        check_points("points", points)?;
         // Some point failed the same test, so it is found (the fallback is
         // never taken).
         let (index, w) = staged

@@ -1,6 +1,7 @@
 //! Which build of the multiversioned kernels this processor runs: the score
-//! terms (`batch.rs`, eq. 1, 4, 5), the scan's cell keys (`pairs.rs`) and the
-//! moments (`moments.rs`) each come in an AVX-512, an AVX2 and a NEON build
+//! terms (`batch.rs`, eq. 1, 4, 5), the scan's cell keys (`pairs.rs`), the
+//! moments (`moments.rs`) and an inserted scan's points and cells
+//! (`staging.rs`, eq. 2) each come in an AVX-512, an AVX2 and a NEON build
 //! besides the generic one, picked at run time. Benchmarks report it beside
 //! the processor, since the same code runs at different speeds on each.
 
@@ -65,7 +66,7 @@ mod tests {
             .collect()
     }
 
-    /// The kernels (`batch.rs`, `moments.rs`, `pairs.rs`) and
+    /// The kernels (`batch.rs`, `moments.rs`, `pairs.rs`, `staging.rs`) and
     /// [`vector_extension`] have the same targets, in the same order, so the
     /// build named is the one the kernels run.
     #[test]
@@ -76,6 +77,7 @@ mod tests {
             include_str!("batch.rs"),
             include_str!("moments.rs"),
             include_str!("pairs.rs"),
+            include_str!("staging.rs"),
         ] {
             let theirs = targets(source);
             assert!(!theirs.is_empty());

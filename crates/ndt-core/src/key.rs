@@ -6,6 +6,20 @@ use nalgebra::Vector2;
 /// and coarse levels never overflow `i32`.
 pub const MAX_INDEX: i32 = 1 << 30;
 
+/// `1.5 · 2⁵²`: adding it rounds to an integer held in the low mantissa bits.
+const ROUND: f64 = 6_755_399_441_055_744.0;
+
+/// `⌊v⌋` without a conversion instruction (they do not vectorise): adding
+/// [`ROUND`] rounds `v` to the nearest integer, held in the low bits (exact
+/// for |v| < 2⁵¹), then one down where that is above `v`. The same as
+/// [`CellKey::of`]'s index wherever [`floor_in_range`] holds; meaningless
+/// elsewhere.
+#[inline(always)]
+pub(crate) fn floor_by_rounding(v: f64) -> i32 {
+    let r = v + ROUND;
+    (r.to_bits() as i32).wrapping_sub(i32::from(r - ROUND > v))
+}
+
 /// Whether `|⌊v⌋| < MAX_INDEX` (false for NaN), without a branch.
 #[inline(always)]
 pub(crate) fn floor_in_range(v: f64) -> bool {

@@ -25,7 +25,7 @@ use nalgebra::Vector2;
 
 use crate::batch::{pass_terms, Chunk, LaneSums, PassTerms, Scan, LANES, SUMS};
 use crate::distributions::{CursorVisitor, DistLookup, Distributions};
-use crate::key::{floor_in_range, CellKey};
+use crate::key::{floor_by_rounding, floor_in_range, CellKey};
 use crate::neighbor::nearest_in_rings_counted;
 use crate::score::Order;
 use crate::se2::Pose2;
@@ -286,9 +286,6 @@ pub fn chunk_weights(
     weights.and_then(|w| w.get(index * size..index * size + len))
 }
 
-/// `1.5 · 2⁵²`: adding it rounds to an integer held in the low mantissa bits.
-const ROUND: f64 = 6_755_399_441_055_744.0;
-
 /// The cell of every point at a pose (`sin θ, cos θ, tx, ty`, then `1 /
 /// cell size`): into `fresh`, with per chunk the lanes whose cell exists
 /// (`valid`: as [`CellKey::of`] gives `Some`, the same index) and the valid
@@ -321,13 +318,8 @@ fn cell_keys(
             let vx = (cs * x - sn * y + tx) * inv;
             let vy = (sn * x + cs * y + ty) * inv;
             ok[l] = floor_in_range(vx) & floor_in_range(vy);
-            // ⌊v⌋ without a conversion instruction (they do not vectorise):
-            // adding 1.5 · 2⁵² rounds v to the nearest integer, held in the
-            // low bits (exact for |v| < 2⁵¹; lanes out of range are not
-            // valid anyway), then one down where that is above v.
-            let (rx, ry) = (vx + ROUND, vy + ROUND);
-            let ix = (rx.to_bits() as i32).wrapping_sub(i32::from(rx - ROUND > vx));
-            let iy = (ry.to_bits() as i32).wrapping_sub(i32::from(ry - ROUND > vy));
+            // Lanes out of range are not valid anyway.
+            let (ix, iy) = (floor_by_rounding(vx), floor_by_rounding(vy));
             fresh.ix[l] = ix;
             fresh.iy[l] = iy;
             eq[l] = ix == kept.ix[l] && iy == kept.iy[l];
