@@ -495,11 +495,10 @@ fn update_shaped(
         x > 0 && y > 0 && x < side - 1 && y < side - 1
     };
     let mut searched = Vec::with_capacity(touched.len());
-    let mut minority = Vec::with_capacity(if options.fuse_minority {
-        touched.len()
-    } else {
-        0
-    });
+    // The touched cells whose minority flag changes (most keep theirs: a
+    // read of the mask costs less than a write).
+    let mut flips = Vec::new();
+    let mut flags = search.minority.reader();
     // The other touched cells: gone, or a new mean under a shape; their
     // minority flags; those to search.
     let mut sums = cells.cursor();
@@ -514,18 +513,16 @@ fn update_shaped(
             _ => {}
         }
         if options.fuse_minority {
-            minority.push(is_minority(own));
+            let now = is_minority(own);
+            if flags.contains(key) != now {
+                flips.push((key, now));
+            }
         }
         if !inside(key) || kind == Some(Ancestor::Unshaped) {
             searched.push(key);
         }
     }
-    if options.fuse_minority {
-        let mut flags = minority.into_iter();
-        search
-            .minority
-            .set_each(touched, |_| flags.next().unwrap_or(false));
-    }
+    search.minority.set_pairs(flips);
     let unshaped = with_minority_neighbours(search, options, &searched, |k| {
         kinds.of(store, ancestor_of(k)) == Some(Ancestor::Unshaped)
     });
