@@ -479,10 +479,7 @@ fn update_shaped(
     }
     // What an ancestor is now, `None` when it changed kind (its cells are
     // set above); the last one asked about remembered.
-    let mut kinds = AncestorKinds {
-        changed: &changed,
-        last: None,
-    };
+    let mut kinds = AncestorKinds::new(&changed);
     // A new distribution of their own for those without a shape, and with
     // fusion for their minority neighbours without one (a cell gone or
     // changed changes its neighbours' fused sums). A touched cell inside its
@@ -531,22 +528,38 @@ fn update_shaped(
     });
 }
 
-/// The kinds of ancestors during one shaped update, remembering the last
-/// one asked about.
+/// The kinds of ancestors during one shaped update (fixed by then),
+/// remembered in 16 slots by the ancestor index's low bits: a cell's
+/// neighbours, and the touched cells' runs, lie under nearby ancestors.
 struct AncestorKinds<'a> {
     changed: &'a FxHashSet<CellKey>,
-    last: Option<(CellKey, Option<Ancestor>)>,
+    memo: [(CellKey, Option<Ancestor>); 16],
 }
 
-impl AncestorKinds<'_> {
+impl<'a> AncestorKinds<'a> {
+    fn new(changed: &'a FxHashSet<CellKey>) -> Self {
+        // No ancestor index is i32::MIN (|index| < 2³⁰).
+        let none = CellKey {
+            ix: i32::MIN,
+            iy: i32::MIN,
+        };
+        Self {
+            changed,
+            memo: [(none, None); 16],
+        }
+    }
+
     /// `None` for an ancestor that changed kind in this update.
     #[inline]
     fn of(&mut self, store: &ShapedStore, at: CellKey) -> Option<Ancestor> {
-        match self.last {
-            Some((k, kind)) if k == at => kind,
+        let slot = ((at.ix & 3) | (at.iy & 3) << 2) as usize;
+        match self.memo.get(slot) {
+            Some(&(k, kind)) if k == at => kind,
             _ => {
                 let kind = (!self.changed.contains(&at)).then(|| store.ancestor(at));
-                self.last = Some((at, kind));
+                if let Some(m) = self.memo.get_mut(slot) {
+                    *m = (at, kind);
+                }
                 kind
             }
         }
