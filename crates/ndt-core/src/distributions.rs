@@ -505,7 +505,11 @@ fn update_shaped(
         match (own, kind) {
             (None, _) => store.remove(key),
             (Some(stats), Some(Ancestor::Shaped(slot))) => {
-                set_shared(store, cell_size, key, stats, slot);
+                // The ancestor kept its kind (`kinds`: `None` otherwise),
+                // so the cell holds no part of its own.
+                if let Some(mean) = stats.mean() {
+                    store.set_shared_again(key, key.center(cell_size) + mean, slot);
+                }
             }
             _ => {}
         }

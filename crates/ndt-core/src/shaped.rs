@@ -141,6 +141,25 @@ impl ShapedStore {
         }
     }
 
+    /// As [`ShapedStore::set_shared`] for a cell known to hold no part of
+    /// its own (one under an ancestor that was [`Ancestor::Shaped`] before
+    /// the change and still is: its cells all share that part): the entry
+    /// is written without reading the one it replaces, so a write that
+    /// misses the cache need not wait for the line.
+    #[inline]
+    pub fn set_shared_again(&mut self, key: CellKey, mean: Vector2<f64>, slot: u32) {
+        debug_assert!(
+            self.cells.get(key).is_none_or(|e| !e.private),
+            "a cell under a shaped ancestor holds a part of its own"
+        );
+        let entry = Entry {
+            mean,
+            part: slot,
+            private: false,
+        };
+        self.cells.insert(key, entry);
+    }
+
     /// Cell `key` has distribution `g` of its own (`None`: it has none).
     pub fn set_own(&mut self, key: CellKey, g: Option<Gaussian>) {
         let Some(g) = g else {
