@@ -58,7 +58,7 @@ pub struct Pyramid {
     /// mapper's helper thread may hold (BENCHMARK.md, "Speed", session 27).
     spare: Vec<Vec<CellKey>>,
     /// Per level, per index of a cell's value: the number of the last
-    /// [`Pyramid::refresh_parents`] that met the cell ([`Stamps`]).
+    /// update that met the cell ([`Stamps`]).
     stamps: Stamps,
     /// Per changed parent of one level: the index of its value, or
     /// [`NEW_PARENT`] (reused between updates).
@@ -70,23 +70,25 @@ pub struct Pyramid {
 /// A parent cell that had no value when it was met.
 const NEW_PARENT: u32 = u32::MAX;
 
-/// Which coarse cells one [`Pyramid::refresh_parents`] has met already: a
-/// number per cell, compared with the call's own, instead of a set of keys
-/// (one look-up finds the cell's value and its mark, and the same index then
-/// takes its new sums without a second look-up).
+/// Which cells one update of a level ([`Pyramid::add_fine`],
+/// [`Pyramid::refresh_parents`]) has met already: a mark per cell, compared
+/// with the update's number, instead of a set of keys (one look-up finds the
+/// cell's value and its mark, and the same index then takes its new sums
+/// without a second look-up). The numbers are bytes: a byte a cell, and
+/// every 255 updates all marks are cleared once, so that no old mark equals
+/// a new number.
 #[derive(Debug, Clone, Default)]
 struct Stamps {
-    call: u32,
-    levels: Vec<Vec<u32>>,
+    call: u8,
+    levels: Vec<Vec<u8>>,
 }
 
 impl Stamps {
-    /// Starts a new call: no cell is met yet.
+    /// Starts a new update: no cell is met yet.
     fn next_call(&mut self, levels: usize) {
         self.levels.resize_with(levels, Vec::new);
         self.call = self.call.wrapping_add(1);
         if self.call == 0 {
-            // After 2³² calls: old marks could equal new numbers.
             for l in &mut self.levels {
                 l.fill(0);
             }
@@ -116,7 +118,7 @@ impl Stamps {
 
     /// Bytes on the heap.
     fn heap_bytes(&self) -> usize {
-        self.levels.iter().map(|l| l.capacity() * 4).sum()
+        self.levels.iter().map(Vec::capacity).sum()
     }
 }
 
@@ -178,8 +180,9 @@ impl Pyramid {
         self.bounds
     }
 
-    /// Bytes on the heap of the update's marks of the coarse cells (one
-    /// word a cell; the levels' own bytes are [`CellTable::heap_bytes`]).
+    /// Bytes on the heap of the updates' marks of the cells met (a byte a
+    /// cell) and their scratch; the levels' own bytes are
+    /// [`CellTable::heap_bytes`].
     pub fn marks_heap_bytes(&self) -> usize {
         self.stamps.heap_bytes()
             + self.parent_slots.capacity() * 4
@@ -451,17 +454,47 @@ mod tests {
         assert_eq!(reused.spare.len(), SPARE_KEYS);
     }
 
-    /// An update's marks of met cells start again at 1 when their number
-    /// wraps (after 2³² updates): a mark left by an update before the wrap
-    /// does not hide a cell from one after it. Started 3 updates before the
-    /// wrap, a pyramid returns the keys and holds the sums of one started
-    /// at 0, through inserts and removals of the same cells.
+    /// A cell met again exactly one cycle of the marks' numbers (255
+    /// updates) after it was last met is met afresh: the marks were cleared
+    /// at the wrap in between.
+    #[test]
+    fn a_cell_met_again_a_whole_cycle_later_is_new_to_the_update() {
+        let (mut cycled, mut plain) = (Pyramid::new(0.02, 2), Pyramid::new(0.02, 2));
+        let at = |x: f64| {
+            let w = Vector2::new(x, 0.01);
+            vec![(CellKey::of(w, 50.0).unwrap(), w)]
+        };
+        // The cell's update, then 254 more (126 inserts elsewhere, of 2
+        // updates each, and one removal of nothing, of 1), then the cell's
+        // again: 255 updates after its mark was set.
+        let mut updates: Vec<Vec<(CellKey, Vector2<f64>)>> = vec![at(0.0)];
+        updates.extend((0..126).map(|_| at(5.0)));
+        for (i, staged) in updates.iter().enumerate() {
+            assert_eq!(cycled.add(staged), plain.add(staged), "insert {i}");
+        }
+        let nothing = [CellKey { ix: 999, iy: 999 }];
+        assert_eq!(cycled.remove(&nothing), plain.remove(&nothing));
+        let again = cycled.add(&at(0.0));
+        assert_eq!(again, plain.add(&at(0.0)));
+        assert_eq!(again[0].len(), 1, "the cell is among the changed ones");
+        assert_eq!(
+            cycled.level(1).unwrap().cells(),
+            plain.level(1).unwrap().cells()
+        );
+    }
+
+    /// An update's marks of met cells are cleared when their number wraps
+    /// (every 255 updates; 0 is never a number): a mark left before a wrap
+    /// does not hide a cell from an update after it. Started 3 updates
+    /// before the wrap and run through more than one more, a pyramid
+    /// returns the keys and holds the sums of one started at 0, through
+    /// inserts and removals of the same cells.
     #[test]
     fn marks_survive_the_wrap_of_their_number() {
         let (mut wrapped, mut plain) = (Pyramid::new(0.02, 4), Pyramid::new(0.02, 4));
-        wrapped.stamps.call = u32::MAX - 3;
+        wrapped.stamps.call = u8::MAX - 3;
         let mut rng = StdRng::seed_from_u64(5);
-        for round in 0..8 {
+        for round in 0..100 {
             let staged: Vec<(CellKey, Vector2<f64>)> = (0..200)
                 .map(|_| {
                     let w = Vector2::new(rng.random_range(-0.3..0.3), rng.random_range(-0.3..0.3));
@@ -476,7 +509,8 @@ mod tests {
                 "round {round}"
             );
         }
-        assert!(wrapped.stamps.call < 100, "the number wrapped");
+        // 300 updates from 252: wrapped twice.
+        assert_eq!(wrapped.stamps.call, 42, "the number wrapped");
         for l in 0..4 {
             let (a, b) = (wrapped.level(l).unwrap(), plain.level(l).unwrap());
             assert_eq!(a.cells(), b.cells(), "level {l}");
