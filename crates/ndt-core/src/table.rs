@@ -188,15 +188,7 @@ impl<T> CellTable<T> {
     where
         T: Default,
     {
-        let (t, slot) = self.tile_of(key);
-        let i = match self.slots[t as usize][slot] {
-            EMPTY => {
-                self.push(t, slot, key, T::default());
-                self.values.len() - 1
-            }
-            i => i as usize,
-        };
-        &mut self.values[i]
+        self.index_or_default(key).1
     }
 
     /// Sets the value at index `index` of the values (as
@@ -210,8 +202,8 @@ impl<T> CellTable<T> {
     }
 
     /// The index of `key`'s value among the values (see [`Cursor::index`])
-    /// and the value, set to `T::default()` first when it has none (as
-    /// [`CellTable::get_or_default`]).
+    /// and the value, set to `T::default()` first when it has none (one
+    /// look-up, as [`CellTable::get_or_default`]).
     #[inline]
     pub fn index_or_default(&mut self, key: CellKey) -> (u32, &mut T)
     where
