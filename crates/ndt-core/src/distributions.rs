@@ -4,6 +4,7 @@
 //! finer than the shape scale the covariance of their ancestor
 //! ([`crate::shape`]).
 
+use nalgebra::Vector2;
 use rustc_hash::FxHashSet;
 
 use crate::cell::{CellStats, Gaussian, MIN_POINTS};
@@ -507,8 +508,8 @@ fn update_shaped(
             (Some(stats), Some(Ancestor::Shaped(slot))) => {
                 // The ancestor kept its kind (`kinds`: `None` otherwise),
                 // so the cell holds no part of its own.
-                if let Some(mean) = stats.mean() {
-                    store.set_shared_again(key, key.center(cell_size) + mean, slot);
+                if let Some(mean) = shared_mean(cell_size, key, stats) {
+                    store.set_shared_again(key, mean, slot);
                 }
             }
             _ => {}
@@ -592,9 +593,16 @@ fn set_cell(
 /// Cell `key` (sums `own`) takes its own mean and the shared part `slot`
 /// (as [`Gaussian::from_shape`] gives it).
 fn set_shared(store: &mut ShapedStore, cell_size: f64, key: CellKey, own: &CellStats, slot: u32) {
-    if let Some(mean) = own.mean() {
-        store.set_shared(key, key.center(cell_size) + mean, slot);
+    if let Some(mean) = shared_mean(cell_size, key, own) {
+        store.set_shared(key, mean, slot);
     }
+}
+
+/// The map-frame mean of cell `key` with sums `own` (about its centre), as a
+/// shaped distribution takes it; `None` without points.
+#[inline]
+fn shared_mean(cell_size: f64, key: CellKey, own: &CellStats) -> Option<Vector2<f64>> {
+    own.mean().map(|mean| key.center(cell_size) + mean)
 }
 
 /// The covariance part of the shaped distributions under ancestor `at`

@@ -240,7 +240,7 @@ impl NdtGrid {
         spare: StagedScan,
     ) -> Result<StagedScan> {
         check_finite("pose", &pose.to_array())?;
-        let (s, c) = pose.theta.sin_cos();
+        let sin_cos = pose.theta.sin_cos();
         let inv = self.inv_cell_size;
         // One pass without an exit per point (eq. 2, then the cell): whether
         // every cell exists is checked once at the end. A non-finite point
@@ -249,7 +249,7 @@ impl NdtGrid {
         // point beyond the lattice.
         let mut staged = spare.points;
         staged.clear();
-        if crate::staging::stage_points(points, [s, c, pose.x, pose.y, inv], &mut staged) {
+        if crate::staging::stage_points(points, pose, sin_cos, inv, &mut staged) {
             return Ok(StagedScan { points: staged });
         }
         check_points("points", points)?;

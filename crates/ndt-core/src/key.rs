@@ -15,7 +15,7 @@ const ROUND: f64 = 6_755_399_441_055_744.0;
 /// [`CellKey::of`]'s index wherever [`floor_in_range`] holds; meaningless
 /// elsewhere.
 #[inline(always)]
-pub(crate) fn floor_by_rounding(v: f64) -> i32 {
+fn floor_by_rounding(v: f64) -> i32 {
     let r = v + ROUND;
     (r.to_bits() as i32).wrapping_sub(i32::from(r - ROUND > v))
 }
@@ -64,6 +64,19 @@ impl CellKey {
     /// [`CellKey::of`] without a branch: the key and whether it exists (the
     /// key is meaningless when it does not), for loops over many points
     /// that check them all at once.
+    /// [`CellKey::of_flagged`] without a conversion instruction
+    /// ([`floor_by_rounding`]), for loops the compiler vectorises: the same
+    /// key wherever the flag holds.
+    #[inline(always)]
+    pub(crate) fn of_flagged_in_lanes(p: Vector2<f64>, inv_cell_size: f64) -> (CellKey, bool) {
+        let (vx, vy) = (p.x * inv_cell_size, p.y * inv_cell_size);
+        let key = CellKey {
+            ix: floor_by_rounding(vx),
+            iy: floor_by_rounding(vy),
+        };
+        (key, floor_in_range(vx) & floor_in_range(vy))
+    }
+
     #[inline(always)]
     pub(crate) fn of_flagged(p: Vector2<f64>, inv_cell_size: f64) -> (CellKey, bool) {
         let (ix, okx) = floor_index(p.x * inv_cell_size);

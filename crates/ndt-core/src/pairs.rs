@@ -25,7 +25,7 @@ use nalgebra::Vector2;
 
 use crate::batch::{pass_terms, Chunk, LaneSums, PassTerms, Scan, LANES, SUMS};
 use crate::distributions::{CursorVisitor, DistLookup, Distributions};
-use crate::key::{floor_by_rounding, floor_in_range, CellKey};
+use crate::key::CellKey;
 use crate::neighbor::nearest_in_rings_counted;
 use crate::score::Order;
 use crate::se2::Pose2;
@@ -314,15 +314,14 @@ fn cell_keys(
         let mut eq = [false; LANES];
         for l in 0..LANES {
             let (x, y) = (ch.x[l], ch.y[l]);
-            // eq. (2) as Pose2::transform_with, then CellKey::of.
-            let vx = (cs * x - sn * y + tx) * inv;
-            let vy = (sn * x + cs * y + ty) * inv;
-            ok[l] = floor_in_range(vx) & floor_in_range(vy);
-            // Lanes out of range are not valid anyway.
-            let (ix, iy) = (floor_by_rounding(vx), floor_by_rounding(vy));
-            fresh.ix[l] = ix;
-            fresh.iy[l] = iy;
-            eq[l] = ix == kept.ix[l] && iy == kept.iy[l];
+            // eq. (2) as Pose2::transform_with, then the cell (lanes out of
+            // range are not valid anyway).
+            let w = Vector2::new(cs * x - sn * y + tx, sn * x + cs * y + ty);
+            let (key, valid) = CellKey::of_flagged_in_lanes(w, inv);
+            ok[l] = valid;
+            fresh.ix[l] = key.ix;
+            fresh.iy[l] = key.iy;
+            eq[l] = key.ix == kept.ix[l] && key.iy == kept.iy[l];
         }
         let (mut v, mut e) = (0u8, 0u8);
         for l in 0..LANES {

@@ -96,16 +96,23 @@ impl Stamps {
         }
     }
 
-    /// Marks the cell of value index `index` on level `level`; `true` when
-    /// this call had not met it. `len`: the level's number of values.
+    /// Room for the marks of `len` values on level `level` (once per level
+    /// and update, not per cell).
+    fn prepare(&mut self, level: usize, len: usize) {
+        if let Some(marks) = self.levels.get_mut(level) {
+            if marks.len() < len {
+                marks.resize(len, 0);
+            }
+        }
+    }
+
+    /// Marks the cell of value index `index` on level `level` (prepared
+    /// for it); `true` when this update had not met it.
     #[inline]
-    fn first_meeting(&mut self, level: usize, index: u32, len: usize) -> bool {
+    fn first_meeting(&mut self, level: usize, index: u32) -> bool {
         let Some(marks) = self.levels.get_mut(level) else {
             return true;
         };
-        if marks.len() < len {
-            marks.resize(len, 0);
-        }
         match marks.get_mut(index as usize) {
             Some(m) if *m == self.call => false,
             Some(m) => {
@@ -238,6 +245,9 @@ impl Pyramid {
     pub(crate) fn add_fine(&mut self, staged: &[(CellKey, Vector2<f64>)]) -> Vec<CellKey> {
         let mut touched = self.keys(staged.len());
         self.stamps.next_call(self.levels.len());
+        // At most one new cell a point.
+        self.stamps
+            .prepare(0, self.levels[0].cells.len() + staged.len());
         let stamps = &mut self.stamps;
         let fine = &mut self.levels[0];
         // Cells new to the level take the values' indices from here on (no
@@ -249,7 +259,7 @@ impl Pyramid {
         let mut flush = |key: CellKey, stats: &CellStats| {
             let (i, cell) = fine.cells.index_or_default(key);
             cell.merge(stats);
-            if stamps.first_meeting(0, i, fine.cells.len()) {
+            if stamps.first_meeting(0, i) {
                 touched.push(key);
                 if i as usize >= before {
                     fresh.push(key);
@@ -315,7 +325,7 @@ impl Pyramid {
             let (lower_levels, upper_levels) = self.levels.split_at_mut(l);
             let (lower, upper) = (&lower_levels[l - 1], &mut upper_levels[0]);
             {
-                let len = upper.cells.len();
+                self.stamps.prepare(l, upper.cells.len());
                 let mut existing = upper.cells.cursor();
                 // Changed children come in runs under one parent: the last
                 // parent is not looked up again.
@@ -327,7 +337,7 @@ impl Pyramid {
                     }
                     last = Some(parent);
                     let first = match existing.index(parent) {
-                        Some(i) => self.stamps.first_meeting(l, i, len).then_some(i),
+                        Some(i) => self.stamps.first_meeting(l, i).then_some(i),
                         None => new_parents.insert(parent).then_some(NEW_PARENT),
                     };
                     if let Some(i) = first {

@@ -48,6 +48,18 @@ struct Entry {
     private: bool,
 }
 
+impl Entry {
+    /// A cell with mean `mean` taking the shared part `slot`.
+    #[inline]
+    fn shared(mean: Vector2<f64>, slot: u32) -> Self {
+        Self {
+            mean,
+            part: slot,
+            private: false,
+        }
+    }
+}
+
 /// What an ancestor gives the cells under it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Ancestor {
@@ -129,12 +141,7 @@ impl ShapedStore {
     /// [`Ancestor::Shaped`]).
     #[inline]
     pub fn set_shared(&mut self, key: CellKey, mean: Vector2<f64>, slot: u32) {
-        let entry = Entry {
-            mean,
-            part: slot,
-            private: false,
-        };
-        if let Some(old) = self.cells.replace(key, entry) {
+        if let Some(old) = self.cells.replace(key, Entry::shared(mean, slot)) {
             if old.private {
                 self.free.push(old.part);
             }
@@ -152,12 +159,7 @@ impl ShapedStore {
             self.cells.get(key).is_none_or(|e| !e.private),
             "a cell under a shaped ancestor holds a part of its own"
         );
-        let entry = Entry {
-            mean,
-            part: slot,
-            private: false,
-        };
-        self.cells.insert(key, entry);
+        self.cells.insert(key, Entry::shared(mean, slot));
     }
 
     /// Cell `key` has distribution `g` of its own (`None`: it has none).

@@ -9,30 +9,30 @@
 use multiversion::multiversion;
 use nalgebra::Vector2;
 
-use crate::key::{floor_by_rounding, floor_in_range, CellKey};
+use crate::key::CellKey;
+use crate::se2::Pose2;
 
 /// Points a pass takes at once.
 const LANES: usize = 8;
 
-/// One point: its map coordinates (eq. 2 as [`crate::se2::Pose2::transform_with`])
-/// and its cell (as [`CellKey::of_flagged`]: the same index wherever the
-/// cell exists), and whether its cell exists.
+/// One point: its map coordinates (eq. 2) and its cell
+/// ([`CellKey::of_flagged_in_lanes`]), and whether its cell exists.
 #[inline(always)]
-fn stage_point(p: [f64; 2], pose: [f64; 5]) -> ((CellKey, Vector2<f64>), bool) {
-    let [sn, cs, tx, ty, inv] = pose;
-    let w = Vector2::new(cs * p[0] - sn * p[1] + tx, sn * p[0] + cs * p[1] + ty);
-    let (vx, vy) = (w.x * inv, w.y * inv);
-    let key = CellKey {
-        ix: floor_by_rounding(vx),
-        iy: floor_by_rounding(vy),
-    };
-    ((key, w), floor_in_range(vx) & floor_in_range(vy))
+fn stage_point(
+    p: [f64; 2],
+    pose: Pose2,
+    sin_cos: (f64, f64),
+    inv: f64,
+) -> ((CellKey, Vector2<f64>), bool) {
+    let w = pose.transform_with(sin_cos, Vector2::new(p[0], p[1]));
+    let (key, ok) = CellKey::of_flagged_in_lanes(w, inv);
+    ((key, w), ok)
 }
 
-/// Appends to `out` every point of `points` seen from the pose `pose`
-/// (`sin θ, cos θ, tx, ty`, then `1 / cell size`) in map coordinates with
-/// its cell, in order; `true` when every cell exists (else the cells of the
-/// points beyond the lattice are meaningless).
+/// Appends to `out` every point of `points` seen from `pose` (`sin_cos`:
+/// of its angle) in map coordinates with its cell on a lattice of
+/// `1 / inv` m, in order; `true` when every cell exists (else the cells of
+/// the points beyond the lattice are meaningless).
 #[multiversion(targets(
     "x86_64+avx512f+avx512dq+avx512vl+avx2+fma+avx",
     "x86_64+avx2+fma+avx",
@@ -40,7 +40,9 @@ fn stage_point(p: [f64; 2], pose: [f64; 5]) -> ((CellKey, Vector2<f64>), bool) {
 ))]
 pub(crate) fn stage_points(
     points: &[[f64; 2]],
-    pose: [f64; 5],
+    pose: Pose2,
+    sin_cos: (f64, f64),
+    inv: f64,
     out: &mut Vec<(CellKey, Vector2<f64>)>,
 ) -> bool {
     out.reserve(points.len());
@@ -51,13 +53,13 @@ pub(crate) fn stage_points(
         let mut staged = [(CellKey { ix: 0, iy: 0 }, Vector2::zeros()); LANES];
         let mut ok = [false; LANES];
         for ((p, s), o) in chunk.iter().zip(&mut staged).zip(&mut ok) {
-            (*s, *o) = stage_point(*p, pose);
+            (*s, *o) = stage_point(*p, pose, sin_cos, inv);
         }
         all &= ok.iter().all(|&o| o);
         out.extend_from_slice(&staged);
     }
     for p in rest {
-        let (s, o) = stage_point(*p, pose);
+        let (s, o) = stage_point(*p, pose, sin_cos, inv);
         all &= o;
         out.push(s);
     }
@@ -101,7 +103,7 @@ mod tests {
                     .collect();
                 let (s, c) = pose.theta.sin_cos();
                 let mut out = Vec::new();
-                let all = stage_points(&points, [s, c, pose.x, pose.y, inv], &mut out);
+                let all = stage_points(&points, pose, (s, c), inv, &mut out);
                 let mut every = true;
                 assert_eq!(out.len(), points.len());
                 for (p, (key, w)) in points.iter().zip(&out) {

@@ -370,12 +370,8 @@ impl<'a, T> Cursor<'a, T> {
     /// The value of `key`, if any (as [`CellTable::get`]).
     #[inline(always)]
     pub fn get(&mut self, key: CellKey) -> Option<&'a T> {
-        let (tile, slot) = split(key);
-        let slots = self.tile_slots(tile)?;
-        match slots.get(slot).copied() {
-            None | Some(EMPTY) => None,
-            Some(i) => self.table.values.get(i as usize),
-        }
+        let i = self.index(key)?;
+        self.table.values.get(i as usize)
     }
 
     /// The tile of index `tile` ([`NONE`] where the table has none), through
