@@ -555,19 +555,23 @@ impl<'a> AncestorKinds<'a> {
     }
 
     /// `None` for an ancestor that changed kind in this update.
-    #[inline]
+    #[inline(always)]
     fn of(&mut self, store: &ShapedStore, at: CellKey) -> Option<Ancestor> {
         let slot = ((at.ix & 3) | (at.iy & 3) << 2) as usize;
         match self.memo.get(slot) {
             Some(&(k, kind)) if k == at => kind,
-            _ => {
-                let kind = (!self.changed.contains(&at)).then(|| store.ancestor(at));
-                if let Some(m) = self.memo.get_mut(slot) {
-                    *m = (at, kind);
-                }
-                kind
-            }
+            _ => self.look_up(store, at, slot),
         }
+    }
+
+    /// [`AncestorKinds::of`] for an ancestor not remembered (out of line).
+    #[inline(never)]
+    fn look_up(&mut self, store: &ShapedStore, at: CellKey, slot: usize) -> Option<Ancestor> {
+        let kind = (!self.changed.contains(&at)).then(|| store.ancestor(at));
+        if let Some(m) = self.memo.get_mut(slot) {
+            *m = (at, kind);
+        }
+        kind
     }
 }
 
