@@ -34,6 +34,17 @@ pub struct DistOptions {
     pub shape_cell: f64,
 }
 
+/// The cells of one level a change of the grid touched: their keys and,
+/// when the pyramid gave them ([`crate::pyramid::Pyramid::changed_indices`]),
+/// the indices of their values among the level's sums, in the same order.
+#[derive(Debug, Clone, Copy)]
+pub struct Changed<'a> {
+    /// The cells' keys.
+    pub keys: &'a [CellKey],
+    /// Per key, the index of its sums' value, if known.
+    pub indices: Option<&'a [u32]>,
+}
+
 /// The distribution of every cell that has one, for one [`DistOptions`].
 #[derive(Debug, Clone)]
 pub struct Distributions {
@@ -148,7 +159,7 @@ impl Distributions {
         &mut self,
         cells: &CellTable<CellStats>,
         cell_size: f64,
-        touched: &[CellKey],
+        touched: Changed<'_>,
         shape: Option<Shape<'_>>,
         shapes: &mut ShapeMemo,
     ) {
@@ -164,7 +175,7 @@ impl Distributions {
                 update_shaped(store, search, cells, cell_size, options, touched, shapes);
             }
             (Store::Own(map), _) => {
-                update_own(map, seen, cells, cell_size, options, touched);
+                update_own(map, seen, cells, cell_size, options, touched.keys);
             }
             // Built with a shape level, updated without one: cannot happen
             // (the grid passes the same depth); rebuild rather than go stale.
@@ -443,9 +454,10 @@ fn update_shaped(
     cells: &CellTable<CellStats>,
     cell_size: f64,
     options: DistOptions,
-    touched: &[CellKey],
+    changed_cells: Changed<'_>,
     mut shapes: ShapeReader<'_, '_>,
 ) {
+    let touched = changed_cells.keys;
     let s = shapes.shape();
     let depth = s.depth();
     let ancestor_of = |k: CellKey| crate::pyramid::coarse_key(k, depth);
@@ -499,9 +511,9 @@ fn update_shaped(
     let mut flags = search.minority.reader();
     // The other touched cells: gone, or a new mean under a shape; their
     // minority flags; those to search.
-    let mut sums = cells.cursor();
-    for &key in touched {
-        let own = sums.get(key);
+    let mut sums = ChangedSums::new(cells, changed_cells.indices);
+    for (n, &key) in touched.iter().enumerate() {
+        let own = sums.get(n, key);
         let kind = kinds.of(store, ancestor_of(key));
         match (own, kind) {
             (None, _) => store.remove(key),
@@ -531,6 +543,39 @@ fn update_shaped(
     own_distributions(cells, cell_size, options, &unshaped, |key, g| {
         store.set_own(key, g);
     });
+}
+
+/// The new sums of the changed cells of one level, in order ([`Changed`]):
+/// by the index of their value where the pyramid gave it (no look-up),
+/// else looked up. The pyramid's indices hold until its next change, which
+/// comes after this update (checked against the keys in debug builds).
+struct ChangedSums<'a> {
+    cells: &'a CellTable<CellStats>,
+    cursor: Cursor<'a, CellStats>,
+    indices: Option<&'a [u32]>,
+}
+
+impl<'a> ChangedSums<'a> {
+    fn new(cells: &'a CellTable<CellStats>, indices: Option<&'a [u32]>) -> Self {
+        Self {
+            cells,
+            cursor: cells.cursor(),
+            indices,
+        }
+    }
+
+    /// The sums of the `n`-th changed cell, `key` (`None`: it has none).
+    #[inline(always)]
+    fn get(&mut self, n: usize, key: CellKey) -> Option<&'a CellStats> {
+        match self.indices {
+            Some(ix) => {
+                let i = ix.get(n).copied();
+                debug_assert_eq!(i.and_then(|i| self.cells.key(i)), Some(key));
+                i.and_then(|i| self.cells.value(i))
+            }
+            None => self.cursor.get(key),
+        }
+    }
 }
 
 /// The kinds of ancestors during one shaped update (fixed by then),

@@ -6,7 +6,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use nalgebra::{Matrix2, Vector2};
 
 use crate::cell::CellStats;
-use crate::distributions::{DistOptions, Distributions};
+use crate::distributions::{Changed, DistOptions, Distributions};
 use crate::error::{check_finite, NdtError, Result};
 use crate::key::{CellKey, KeyBounds, MAX_INDEX};
 use crate::occupancy::OccupancyProbe;
@@ -346,7 +346,17 @@ impl NdtGrid {
             let l = dist.level();
             if let (Some(level), Some(keys)) = (self.pyramid.level(l), touched.get(l)) {
                 let shape = shape_at(&self.pyramid, l, dist.shape_depth());
-                Arc::make_mut(dist).update(level.cells(), level.cell_size(), keys, shape, shapes);
+                let changed = Changed {
+                    keys,
+                    indices: self.pyramid.changed_indices(l),
+                };
+                Arc::make_mut(dist).update(
+                    level.cells(),
+                    level.cell_size(),
+                    changed,
+                    shape,
+                    shapes,
+                );
             }
         }
     }

@@ -60,15 +60,71 @@ pub struct Pyramid {
     /// Per level, per index of a cell's value: the number of the last
     /// update that met the cell ([`Stamps`]).
     stamps: Stamps,
-    /// Per changed parent of one level: the index of its value, or
-    /// [`NEW_PARENT`] (reused between updates).
-    parent_slots: Vec<u32>,
+    /// Per level, the indices of the values of the cells the last update
+    /// changed ([`Pyramid::changed_indices`]).
+    changed: ChangedIndices,
     /// The cells an insert added to the fine level (reused between updates).
     fresh: Vec<CellKey>,
 }
 
 /// A parent cell that had no value when it was met.
 const NEW_PARENT: u32 = u32::MAX;
+
+/// Per level, the indices among the level's values of the cells the last
+/// update changed, in the order of the keys it returned for the level, while
+/// they hold: a new cell's value is pushed, so only a removal on that level
+/// moves one. The distributions' update then reads each changed cell's new
+/// sums without looking the cell up again.
+#[derive(Debug, Clone, Default)]
+struct ChangedIndices {
+    /// Per level (reused between updates).
+    levels: Vec<Vec<u32>>,
+    /// Per level: whether `levels` holds the last update's indices.
+    valid: Vec<bool>,
+}
+
+impl ChangedIndices {
+    /// Level `level`'s vector, emptied, for an update that fills it; the
+    /// level counts as not indexed until [`ChangedIndices::done`].
+    fn start(&mut self, level: usize) -> Vec<u32> {
+        if self.levels.len() <= level {
+            self.levels.resize_with(level + 1, Vec::new);
+            self.valid.resize(level + 1, false);
+        }
+        self.valid[level] = false;
+        let mut v = std::mem::take(&mut self.levels[level]);
+        v.clear();
+        v
+    }
+
+    /// Puts back level `level`'s vector; `hold`: its indices are those of
+    /// the update's changed cells.
+    fn done(&mut self, level: usize, indices: Vec<u32>, hold: bool) {
+        if let (Some(l), Some(v)) = (self.levels.get_mut(level), self.valid.get_mut(level)) {
+            *l = indices;
+            *v = hold;
+        }
+    }
+
+    /// Level `level` is not indexed by the last update.
+    fn forget(&mut self, level: usize) {
+        if let Some(v) = self.valid.get_mut(level) {
+            *v = false;
+        }
+    }
+
+    fn get(&self, level: usize) -> Option<&[u32]> {
+        match self.valid.get(level) {
+            Some(true) => self.levels.get(level).map(Vec::as_slice),
+            _ => None,
+        }
+    }
+
+    /// Bytes on the heap.
+    fn heap_bytes(&self) -> usize {
+        self.levels.iter().map(|l| l.capacity() * 4).sum::<usize>() + self.valid.capacity()
+    }
+}
 
 /// Which cells one update of a level ([`Pyramid::add_fine`],
 /// [`Pyramid::refresh_parents`]) has met already: a mark per cell, compared
@@ -155,7 +211,7 @@ impl Pyramid {
             seen: KeyScratch::default(),
             spare: Vec::with_capacity(SPARE_KEYS),
             stamps: Stamps::default(),
-            parent_slots: Vec::new(),
+            changed: ChangedIndices::default(),
             fresh: Vec::new(),
         }
     }
@@ -192,8 +248,19 @@ impl Pyramid {
     /// [`CellTable::heap_bytes`].
     pub fn marks_heap_bytes(&self) -> usize {
         self.stamps.heap_bytes()
-            + self.parent_slots.capacity() * 4
+            + self.changed.heap_bytes()
             + self.fresh.capacity() * std::mem::size_of::<CellKey>()
+    }
+
+    /// The indices among level `level`'s values (as
+    /// [`crate::table::Cursor::index`] gives them) of the cells the last
+    /// update ([`Pyramid::add`], [`Pyramid::remove`], [`Pyramid::refresh`])
+    /// changed there, in the order of the keys it returned for the level;
+    /// `None` when that update removed a cell there (a removal moves an
+    /// index) or, on the fine level, did not add the points itself. They
+    /// hold until the pyramid changes again.
+    pub fn changed_indices(&self, level: usize) -> Option<&[u32]> {
+        self.changed.get(level)
     }
 
     /// The occupied fine cells.
@@ -255,12 +322,14 @@ impl Pyramid {
         let before = fine.cells.len();
         let fresh = &mut self.fresh;
         fresh.clear();
+        let mut indices = self.changed.start(0);
         let mut run: Option<(CellKey, CellStats)> = None;
         let mut flush = |key: CellKey, stats: &CellStats| {
             let (i, cell) = fine.cells.index_or_default(key);
             cell.merge(stats);
             if stamps.first_meeting(0, i) {
                 touched.push(key);
+                indices.push(i);
                 if i as usize >= before {
                     fresh.push(key);
                 }
@@ -283,6 +352,8 @@ impl Pyramid {
         if let Some((k, stats)) = run {
             flush(k, &stats);
         }
+        // No removal here: the indices hold.
+        self.changed.done(0, indices, true);
         // Only new cells change the occupancy, or can lie beyond the bounds.
         self.occupied.insert(&self.fresh);
         if let Some(added) = KeyBounds::of_keys(self.fresh.iter().copied()) {
@@ -305,6 +376,7 @@ impl Pyramid {
         let mut once = self.keys(fine.len());
         let seen = self.seen.take();
         once.extend(fine.iter().copied().filter(|&k| seen.insert(k)));
+        self.changed.forget(0);
         self.refresh_parents(once)
     }
 
@@ -315,11 +387,12 @@ impl Pyramid {
         let mut touched_all: Vec<Vec<CellKey>> = Vec::with_capacity(self.levels.len());
         touched_all.push(fine);
         self.stamps.next_call(self.levels.len());
-        let mut slots = std::mem::take(&mut self.parent_slots);
         for l in 1..self.levels.len() {
             let below = touched_all[l - 1].len();
             let mut changed = self.keys(below);
-            slots.clear();
+            // Per changed parent: the index of its value, or NEW_PARENT;
+            // then the index of its new value.
+            let mut slots = self.changed.start(l);
             // Parents that have no cell yet are kept apart by key.
             let new_parents = self.seen.take();
             let (lower_levels, upper_levels) = self.levels.split_at_mut(l);
@@ -351,22 +424,26 @@ impl Pyramid {
             let none = CellStats::default();
             // The values' indices hold until a removal moves one.
             let mut indices_hold = true;
-            for (&parent, &i) in changed.iter().zip(&slots) {
+            for (&parent, i) in changed.iter().zip(&mut slots) {
                 // Children's sums are about their own centres, ±½ a child
                 // cell from the parent's (crate::gather).
                 let sum = gather::quad(&children.quad(parent, &none), lower.cell_size);
                 if sum.count == 0 {
                     upper.cells.remove(parent);
                     indices_hold = false;
-                } else if i != NEW_PARENT && indices_hold {
-                    upper.cells.set_at(i, sum);
+                } else if *i != NEW_PARENT && indices_hold {
+                    upper.cells.set_at(*i, sum);
                 } else {
                     upper.cells.insert(parent, sum);
+                    if *i == NEW_PARENT {
+                        // A new cell's value is pushed: the last one.
+                        *i = (upper.cells.len() - 1) as u32;
+                    }
                 }
             }
+            self.changed.done(l, slots, indices_hold);
             touched_all.push(changed);
         }
-        self.parent_slots = slots;
         touched_all
     }
 }
@@ -392,6 +469,7 @@ impl Pyramid {
                 removed.push(key);
             }
         }
+        self.changed.forget(0);
         self.occupied.remove(&removed);
         if self.levels[0].cells.is_empty() {
             self.bounds = None;
@@ -410,6 +488,7 @@ impl Pyramid {
         for level in &mut self.levels[1..] {
             level.cells.clear();
         }
+        self.changed.forget(0);
         self.refresh_parents(states.iter().map(|(k, _)| *k).collect());
     }
 }
@@ -462,6 +541,62 @@ mod tests {
         }
         reused.give_back((0..3 * SPARE_KEYS).map(|_| vec![CellKey { ix: 0, iy: 0 }]));
         assert_eq!(reused.spare.len(), SPARE_KEYS);
+    }
+
+    /// Checks the indices of the last update against the keys it returned:
+    /// per level, either the index of each changed cell's value, in order,
+    /// or none, and then (a removal moves indices) some changed cell was
+    /// removed there; on the fine level none when `fine_indexed` is false.
+    fn assert_changed_indices(p: &Pyramid, changed: &[Vec<CellKey>], fine_indexed: bool) {
+        for (l, keys) in changed.iter().enumerate() {
+            let cells = p.level(l).unwrap().cells();
+            match p.changed_indices(l) {
+                Some(ix) => {
+                    assert!(l > 0 || fine_indexed, "the fine level is not indexed");
+                    assert_eq!(ix.len(), keys.len(), "level {l}");
+                    for (&i, &k) in ix.iter().zip(keys) {
+                        assert_eq!(cells.key(i), Some(k), "level {l}");
+                        assert_eq!(cells.value(i), cells.get(k), "level {l}");
+                    }
+                }
+                None if l == 0 && !fine_indexed => {}
+                None => assert!(
+                    keys.iter().any(|&k| !cells.contains(k)),
+                    "level {l}: no index, but no cell was removed"
+                ),
+            }
+        }
+    }
+
+    /// An insert gives the indices of every level's changed cells; a
+    /// removal those of the coarse levels where no cell went (a level that
+    /// lost one gives none), a deferred refresh those of the coarse levels.
+    #[test]
+    fn changed_indices_point_at_the_changed_cells() {
+        let mut rng = StdRng::seed_from_u64(7);
+        let mut p = Pyramid::new(0.02, 4);
+        let mut unindexed = 0;
+        for _ in 0..40 {
+            let staged: Vec<(CellKey, Vector2<f64>)> = (0..rng.random_range(1..200))
+                .map(|_| {
+                    let w = Vector2::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5));
+                    (CellKey::of(w, 50.0).unwrap(), w)
+                })
+                .collect();
+            let changed = p.add(&staged);
+            assert_changed_indices(&p, &changed, true);
+            assert!((0..4).all(|l| p.changed_indices(l).is_some()));
+            p.give_back(changed);
+            let gone: Vec<CellKey> = staged.iter().step_by(2).map(|(k, _)| *k).collect();
+            let changed = p.remove(&gone);
+            assert_changed_indices(&p, &changed, false);
+            unindexed += (1..4).filter(|&l| p.changed_indices(l).is_none()).count();
+            p.give_back(changed);
+            let fine = p.add_fine(&staged);
+            let changed = p.refresh(&fine);
+            assert_changed_indices(&p, &changed, false);
+        }
+        assert!(unindexed > 0, "some removal emptied a coarse cell");
     }
 
     /// A cell met again exactly one cycle of the marks' numbers (255

@@ -201,6 +201,20 @@ impl<T> CellTable<T> {
         }
     }
 
+    /// The value at index `index` of the values (as [`Cursor::index`] or
+    /// [`CellTable::index_or_default`] gave it: a new key's value is pushed,
+    /// so only a removal moves an index); `None` out of range. No look-up.
+    #[inline]
+    pub fn value(&self, index: u32) -> Option<&T> {
+        self.values.get(index as usize)
+    }
+
+    /// The key of the value at index `index` (see [`CellTable::value`]).
+    #[inline]
+    pub fn key(&self, index: u32) -> Option<CellKey> {
+        self.keys.get(index as usize).copied()
+    }
+
     /// The index of `key`'s value among the values (see [`Cursor::index`])
     /// and the value, set to `T::default()` first when it has none (one
     /// look-up, as [`CellTable::get_or_default`]).
