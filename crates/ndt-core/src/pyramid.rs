@@ -65,6 +65,9 @@ pub struct Pyramid {
     changed: ChangedIndices,
     /// The cells an insert added to the fine level (reused between updates).
     fresh: Vec<CellKey>,
+    /// The parents of one level's runs of changed cells (reused between
+    /// updates).
+    runs: Vec<CellKey>,
 }
 
 /// A parent cell that had no value when it was met.
@@ -170,10 +173,11 @@ impl Stamps {
             return true;
         };
         match marks.get_mut(index as usize) {
-            Some(m) if *m == self.call => false,
+            // Written either way: no branch on whether it was met.
             Some(m) => {
+                let first = *m != self.call;
                 *m = self.call;
-                true
+                first
             }
             None => true,
         }
@@ -213,6 +217,7 @@ impl Pyramid {
             stamps: Stamps::default(),
             changed: ChangedIndices::default(),
             fresh: Vec::new(),
+            runs: Vec::new(),
         }
     }
 
@@ -249,7 +254,7 @@ impl Pyramid {
     pub fn marks_heap_bytes(&self) -> usize {
         self.stamps.heap_bytes()
             + self.changed.heap_bytes()
-            + self.fresh.capacity() * std::mem::size_of::<CellKey>()
+            + (self.fresh.capacity() + self.runs.capacity()) * std::mem::size_of::<CellKey>()
     }
 
     /// The indices among level `level`'s values (as
@@ -400,24 +405,42 @@ impl Pyramid {
             {
                 self.stamps.prepare(l, upper.cells.len());
                 let mut existing = upper.cells.cursor();
-                // Changed children come in runs under one parent: the last
-                // parent is not looked up again.
+                // Changed children come in runs under one parent: each run's
+                // parent once, without a branch per child (whether a child
+                // starts a run follows the map's shapes, which no predictor
+                // learns). A write at `n` stays until a new parent moves `n`.
+                let runs = &mut self.runs;
+                let lower_keys = &touched_all[l - 1];
+                runs.clear();
+                runs.resize(lower_keys.len(), CellKey { ix: 0, iy: 0 });
+                let mut n = 0;
                 let mut last = None;
-                for &child in &touched_all[l - 1] {
+                for &child in lower_keys {
                     let parent = coarse_key(child, 1);
-                    if last == Some(parent) {
-                        continue;
+                    if let Some(r) = runs.get_mut(n) {
+                        *r = parent;
                     }
+                    n += usize::from(last != Some(parent));
                     last = Some(parent);
-                    let first = match existing.index(parent) {
-                        Some(i) => self.stamps.first_meeting(l, i).then_some(i),
-                        None => new_parents.insert(parent).then_some(NEW_PARENT),
-                    };
-                    if let Some(i) = first {
-                        changed.push(parent);
-                        slots.push(i);
-                    }
                 }
+                runs.truncate(n);
+                // Each parent met first kept, again without a branch: the
+                // entry at `n` is written, and kept by moving `n` past it.
+                changed.resize(runs.len(), CellKey { ix: 0, iy: 0 });
+                slots.resize(runs.len(), NEW_PARENT);
+                let mut n = 0;
+                for &parent in runs.iter() {
+                    let (first, i) = match existing.index(parent) {
+                        Some(i) => (self.stamps.first_meeting(l, i), i),
+                        None => (new_parents.insert(parent), NEW_PARENT),
+                    };
+                    if let (Some(c), Some(s)) = (changed.get_mut(n), slots.get_mut(n)) {
+                        (*c, *s) = (parent, i);
+                    }
+                    n += usize::from(first);
+                }
+                changed.truncate(n);
+                slots.truncate(n);
             }
             // The 4 children of a parent share a tile: one tile look-up at most.
             let mut children = lower.cells.cursor();
