@@ -500,9 +500,11 @@ fn update_shaped(
     // ancestor, so when that one is not shapeless neither the cell nor a
     // neighbour is wanted: such cells are left out of the search.
     let side = 1i32 << depth;
-    let inside = |k: CellKey| {
-        let (x, y) = (k.ix & (side - 1), k.iy & (side - 1));
-        x > 0 && y > 0 && x < side - 1 && y < side - 1
+    // The step to the ancestors next to cell `k`'s along each axis: −1 or
+    // 1 on a border of its ancestor, 0 inside.
+    let across = |k: CellKey| {
+        let step = |p: i32| i32::from(p == side - 1) - i32::from(p == 0);
+        (step(k.ix & (side - 1)), step(k.iy & (side - 1)))
     };
     let mut searched = Vec::with_capacity(touched.len());
     // The touched cells whose minority flag changes (most keep theirs: a
@@ -532,7 +534,18 @@ fn update_shaped(
                 flips.push((key, now));
             }
         }
-        if !inside(key) || kind == Some(Ancestor::Unshaped) {
+        // Only cells under a shapeless ancestor are wanted: a cell is
+        // searched when its own or one across its border is shapeless.
+        let wanted_around = kind == Some(Ancestor::Unshaped) || {
+            let (dx, dy) = across(key);
+            let at = ancestor_of(key);
+            let mut shapeless =
+                |dx: i32, dy: i32| kinds.of(store, at.offset(dx, dy)) == Some(Ancestor::Unshaped);
+            (dx != 0 && shapeless(dx, 0))
+                || (dy != 0 && shapeless(0, dy))
+                || (dx != 0 && dy != 0 && shapeless(dx, dy))
+        };
+        if wanted_around {
             searched.push(key);
         }
     }
