@@ -63,6 +63,19 @@ impl CellStats {
         self.count as i64 as f64
     }
 
+    /// These sums when `keep`, else empty sums, without a branch (bit masks:
+    /// the same bits as [`CellStats::default`] when not kept).
+    #[inline(always)]
+    pub fn kept_if(&self, keep: bool) -> CellStats {
+        let mask = 0u64.wrapping_sub(u64::from(keep));
+        let f = |v: f64| f64::from_bits(v.to_bits() & mask);
+        CellStats {
+            count: self.count & mask,
+            sum: self.sum.map(f),
+            scatter: self.scatter.map(f),
+        }
+    }
+
     /// eq. (6) for one point `x − o` \[m\].
     #[inline]
     pub fn add_point(&mut self, d: Vector2<f64>) {
@@ -255,6 +268,24 @@ mod tests {
     use super::*;
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
+
+    /// `kept_if` keeps every bit, or gives the bits of empty sums (a
+    /// negative zero, a NaN and an infinity too).
+    #[test]
+    fn kept_if_keeps_the_bits_or_empties_them() {
+        let s = CellStats {
+            count: 7,
+            sum: Vector2::new(-0.0, f64::NAN),
+            scatter: Matrix2::new(1.5, -2.25, f64::INFINITY, -1e-300),
+        };
+        let bits = |c: &CellStats| {
+            let mut v = vec![c.count];
+            v.extend(c.sum.iter().chain(c.scatter.iter()).map(|x| x.to_bits()));
+            v
+        };
+        assert_eq!(bits(&s.kept_if(true)), bits(&s));
+        assert_eq!(bits(&s.kept_if(false)), bits(&CellStats::default()));
+    }
 
     /// The trigonometric form the closed form replaces.
     fn by_angle(m: &Matrix2<f64>) -> Vector2<f64> {

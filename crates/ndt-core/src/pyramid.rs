@@ -68,6 +68,9 @@ pub struct Pyramid {
     /// The parents of one level's runs of changed cells (reused between
     /// updates).
     runs: Vec<CellKey>,
+    /// An insert's runs of points in one cell, with their sums (reused
+    /// between updates).
+    run_sums: Vec<(CellKey, CellStats)>,
 }
 
 /// A parent cell that had no value when it was met.
@@ -218,6 +221,7 @@ impl Pyramid {
             changed: ChangedIndices::default(),
             fresh: Vec::new(),
             runs: Vec::new(),
+            run_sums: Vec::new(),
         }
     }
 
@@ -255,6 +259,7 @@ impl Pyramid {
         self.stamps.heap_bytes()
             + self.changed.heap_bytes()
             + (self.fresh.capacity() + self.runs.capacity()) * std::mem::size_of::<CellKey>()
+            + self.run_sums.capacity() * std::mem::size_of::<(CellKey, CellStats)>()
     }
 
     /// The indices among level `level`'s values (as
@@ -328,34 +333,40 @@ impl Pyramid {
         let fresh = &mut self.fresh;
         fresh.clear();
         let mut indices = self.changed.start(0);
-        let mut run: Option<(CellKey, CellStats)> = None;
-        let mut flush = |key: CellKey, stats: &CellStats| {
-            let (i, cell) = fine.cells.index_or_default(key);
-            cell.merge(stats);
-            if stamps.first_meeting(0, i) {
-                touched.push(key);
-                indices.push(i);
-                if i as usize >= before {
-                    fresh.push(key);
-                }
-            }
-        };
+        // Runs of points in one cell (scan points come in beam order) summed
+        // first, each run written at `n` at every point and kept by moving
+        // `n` when the next point starts a new run: no branch per point on
+        // where a run ends (that follows the map's shapes).
+        let runs = &mut self.run_sums;
+        if runs.len() < staged.len() {
+            runs.resize(
+                staged.len(),
+                (CellKey { ix: 0, iy: 0 }, CellStats::default()),
+            );
+        }
+        let mut n = 0;
+        let mut last = None;
+        let mut sums = CellStats::default();
         for &(key, w) in staged {
-            let centre = key.center(fine.cell_size);
-            match &mut run {
-                Some((k, stats)) if *k == key => stats.add_point(w - centre),
-                _ => {
-                    if let Some((k, stats)) = run.take() {
-                        flush(k, &stats);
-                    }
-                    let mut stats = CellStats::default();
-                    stats.add_point(w - centre);
-                    run = Some((key, stats));
-                }
+            let new = last != Some(key);
+            last = Some(key);
+            n += usize::from(new);
+            sums = sums.kept_if(!new);
+            sums.add_point(w - key.center(fine.cell_size));
+            if let Some(r) = runs.get_mut(n.wrapping_sub(1)) {
+                *r = (key, sums);
             }
         }
-        if let Some((k, stats)) = run {
-            flush(k, &stats);
+        for (key, stats) in runs.iter().take(n) {
+            let (i, cell) = fine.cells.index_or_default(*key);
+            cell.merge(stats);
+            if stamps.first_meeting(0, i) {
+                touched.push(*key);
+                indices.push(i);
+                if i as usize >= before {
+                    fresh.push(*key);
+                }
+            }
         }
         // No removal here: the indices hold.
         self.changed.done(0, indices, true);
