@@ -12,6 +12,10 @@ use crate::occupancy::Occupancy;
 use crate::scratch::KeyScratch;
 use crate::table::CellTable;
 
+mod bookkeeping;
+
+use bookkeeping::{ChangedIndices, Stamps};
+
 /// Most levels a grid may have (fine level included).
 pub const MAX_LEVELS: usize = 12;
 
@@ -75,122 +79,6 @@ pub struct Pyramid {
 
 /// A parent cell that had no value when it was met.
 const NEW_PARENT: u32 = u32::MAX;
-
-/// Per level, the indices among the level's values of the cells the last
-/// update changed, in the order of the keys it returned for the level, while
-/// they hold: a new cell's value is pushed, so only a removal on that level
-/// moves one. The distributions' update then reads each changed cell's new
-/// sums without looking the cell up again.
-#[derive(Debug, Clone, Default)]
-struct ChangedIndices {
-    /// Per level (reused between updates).
-    levels: Vec<Vec<u32>>,
-    /// Per level: whether `levels` holds the last update's indices.
-    valid: Vec<bool>,
-}
-
-impl ChangedIndices {
-    /// Level `level`'s vector, emptied, for an update that fills it; the
-    /// level counts as not indexed until [`ChangedIndices::done`].
-    fn start(&mut self, level: usize) -> Vec<u32> {
-        if self.levels.len() <= level {
-            self.levels.resize_with(level + 1, Vec::new);
-            self.valid.resize(level + 1, false);
-        }
-        self.valid[level] = false;
-        let mut v = std::mem::take(&mut self.levels[level]);
-        v.clear();
-        v
-    }
-
-    /// Puts back level `level`'s vector; `hold`: its indices are those of
-    /// the update's changed cells.
-    fn done(&mut self, level: usize, indices: Vec<u32>, hold: bool) {
-        if let (Some(l), Some(v)) = (self.levels.get_mut(level), self.valid.get_mut(level)) {
-            *l = indices;
-            *v = hold;
-        }
-    }
-
-    /// Level `level` is not indexed by the last update.
-    fn forget(&mut self, level: usize) {
-        if let Some(v) = self.valid.get_mut(level) {
-            *v = false;
-        }
-    }
-
-    fn get(&self, level: usize) -> Option<&[u32]> {
-        match self.valid.get(level) {
-            Some(true) => self.levels.get(level).map(Vec::as_slice),
-            _ => None,
-        }
-    }
-
-    /// Bytes on the heap.
-    fn heap_bytes(&self) -> usize {
-        self.levels.iter().map(|l| l.capacity() * 4).sum::<usize>() + self.valid.capacity()
-    }
-}
-
-/// Which cells one update of a level ([`Pyramid::add_fine`],
-/// [`Pyramid::refresh_parents`]) has met already: a mark per cell, compared
-/// with the update's number, instead of a set of keys (one look-up finds the
-/// cell's value and its mark, and the same index then takes its new sums
-/// without a second look-up). The numbers are bytes: a byte a cell, and
-/// every 255 updates all marks are cleared once, so that no old mark equals
-/// a new number.
-#[derive(Debug, Clone, Default)]
-struct Stamps {
-    call: u8,
-    levels: Vec<Vec<u8>>,
-}
-
-impl Stamps {
-    /// Starts a new update: no cell is met yet.
-    fn next_call(&mut self, levels: usize) {
-        self.levels.resize_with(levels, Vec::new);
-        self.call = self.call.wrapping_add(1);
-        if self.call == 0 {
-            for l in &mut self.levels {
-                l.fill(0);
-            }
-            self.call = 1;
-        }
-    }
-
-    /// Room for the marks of `len` values on level `level` (once per level
-    /// and update, not per cell).
-    fn prepare(&mut self, level: usize, len: usize) {
-        if let Some(marks) = self.levels.get_mut(level) {
-            if marks.len() < len {
-                marks.resize(len, 0);
-            }
-        }
-    }
-
-    /// Marks the cell of value index `index` on level `level` (prepared
-    /// for it); `true` when this update had not met it.
-    #[inline]
-    fn first_meeting(&mut self, level: usize, index: u32) -> bool {
-        let Some(marks) = self.levels.get_mut(level) else {
-            return true;
-        };
-        match marks.get_mut(index as usize) {
-            // Written either way: no branch on whether it was met.
-            Some(m) => {
-                let first = *m != self.call;
-                *m = self.call;
-                first
-            }
-            None => true,
-        }
-    }
-
-    /// Bytes on the heap.
-    fn heap_bytes(&self) -> usize {
-        self.levels.iter().map(Vec::capacity).sum()
-    }
-}
 
 /// The key of the level-`level` cell covering fine cell `key`: an arithmetic
 /// shift, i.e. floor division by `2^level` (correct for negative indices).
@@ -264,11 +152,11 @@ impl Pyramid {
 
     /// The indices among level `level`'s values (as
     /// [`crate::table::Cursor::index`] gives them) of the cells the last
-    /// update ([`Pyramid::add`], [`Pyramid::remove`], [`Pyramid::refresh`])
-    /// changed there, in the order of the keys it returned for the level;
-    /// `None` when that update removed a cell there (a removal moves an
-    /// index) or, on the fine level, did not add the points itself. They
-    /// hold until the pyramid changes again.
+    /// update ([`Pyramid::add`], [`Pyramid::remove`], or the grid's
+    /// deferred refresh) changed there, in the order of the keys it returned
+    /// for the level; `None` when that update removed a cell there (a
+    /// removal moves an index) or, on the fine level, did not add the points
+    /// itself. They hold until the pyramid changes again.
     pub fn changed_indices(&self, level: usize) -> Option<&[u32]> {
         self.changed.get(level)
     }
