@@ -422,6 +422,17 @@ mod tests {
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
 
+    /// `n` points uniform in the square of half-side `half` \[m\] about the
+    /// origin, with their 2 cm cells.
+    fn random_points(rng: &mut StdRng, n: usize, half: f64) -> Vec<(CellKey, Vector2<f64>)> {
+        (0..n)
+            .map(|_| {
+                let w = Vector2::new(rng.random_range(-half..half), rng.random_range(-half..half));
+                (CellKey::of(w, 50.0).unwrap(), w)
+            })
+            .collect()
+    }
+
     /// A pyramid given its results back returns the keys and holds the
     /// sums of one given nothing back, in the storage it was given (last
     /// given, first used); it keeps at most `SPARE_KEYS` vectors.
@@ -430,12 +441,8 @@ mod tests {
         let mut rng = StdRng::seed_from_u64(3);
         let (mut reused, mut fresh) = (Pyramid::new(0.02, 4), Pyramid::new(0.02, 4));
         for round in 0..60 {
-            let staged: Vec<(CellKey, Vector2<f64>)> = (0..rng.random_range(1..300))
-                .map(|_| {
-                    let w = Vector2::new(rng.random_range(-2.0..2.0), rng.random_range(-2.0..2.0));
-                    (CellKey::of(w, 50.0).unwrap(), w)
-                })
-                .collect();
+            let n = rng.random_range(1..300);
+            let staged = random_points(&mut rng, n, 2.0);
             let removed: Vec<CellKey> = staged
                 .iter()
                 .step_by(3)
@@ -499,12 +506,8 @@ mod tests {
         let mut p = Pyramid::new(0.02, 4);
         let mut unindexed = 0;
         for _ in 0..40 {
-            let staged: Vec<(CellKey, Vector2<f64>)> = (0..rng.random_range(1..200))
-                .map(|_| {
-                    let w = Vector2::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5));
-                    (CellKey::of(w, 50.0).unwrap(), w)
-                })
-                .collect();
+            let n = rng.random_range(1..200);
+            let staged = random_points(&mut rng, n, 0.5);
             let changed = p.add(&staged);
             assert_changed_indices(&p, &changed, true);
             assert!((0..4).all(|l| p.changed_indices(l).is_some()));
@@ -562,12 +565,7 @@ mod tests {
         wrapped.stamps.call = u8::MAX - 3;
         let mut rng = StdRng::seed_from_u64(5);
         for round in 0..100 {
-            let staged: Vec<(CellKey, Vector2<f64>)> = (0..200)
-                .map(|_| {
-                    let w = Vector2::new(rng.random_range(-0.3..0.3), rng.random_range(-0.3..0.3));
-                    (CellKey::of(w, 50.0).unwrap(), w)
-                })
-                .collect();
+            let staged = random_points(&mut rng, 200, 0.3);
             assert_eq!(wrapped.add(&staged), plain.add(&staged), "round {round}");
             let removed: Vec<CellKey> = staged.iter().step_by(4).map(|(k, _)| *k).collect();
             assert_eq!(
