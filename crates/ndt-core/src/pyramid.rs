@@ -80,6 +80,10 @@ pub struct Pyramid {
 /// A parent cell that had no value when it was met.
 const NEW_PARENT: u32 = u32::MAX;
 
+/// Runs of points ([`Pyramid::add_fine`]) whose storage a pyramid keeps
+/// between inserts (64 bytes each): a scan's, not a whole map's.
+const RUN_KEEP: usize = 4096;
+
 /// The key of the level-`level` cell covering fine cell `key`: an arithmetic
 /// shift, i.e. floor division by `2^level` (correct for negative indices).
 #[inline]
@@ -222,9 +226,10 @@ impl Pyramid {
         fresh.clear();
         let mut indices = self.changed.start(0);
         // Runs of points in one cell (scan points come in beam order) summed
-        // first, each run written at `n` at every point and kept by moving
-        // `n` when the next point starts a new run: no branch per point on
-        // where a run ends (that follows the map's shapes).
+        // first, each run written at `n - 1` at every point and kept by
+        // moving `n` when the next point starts a new run: no branch per
+        // point on where a run ends (that follows the map's shapes). Then
+        // each run into its cell.
         let runs = &mut self.run_sums;
         if runs.len() < staged.len() {
             runs.resize(
@@ -245,16 +250,22 @@ impl Pyramid {
                 *r = (key, sums);
             }
         }
-        for (key, stats) in runs.iter().take(n) {
-            let (i, cell) = fine.cells.index_or_default(*key);
+        for &(key, ref stats) in runs.iter().take(n) {
+            let (i, cell) = fine.cells.index_or_default(key);
             cell.merge(stats);
             if stamps.first_meeting(0, i) {
-                touched.push(*key);
+                touched.push(key);
                 indices.push(i);
                 if i as usize >= before {
-                    fresh.push(*key);
+                    fresh.push(key);
                 }
             }
+        }
+        // The storage of a scan's runs is kept, that of a larger insert's
+        // (a whole map at once) given back.
+        if runs.len() > RUN_KEEP {
+            runs.truncate(RUN_KEEP);
+            runs.shrink_to_fit();
         }
         // No removal here: the indices hold.
         self.changed.done(0, indices, true);
@@ -431,6 +442,64 @@ mod tests {
                 (CellKey::of(w, 50.0).unwrap(), w)
             })
             .collect()
+    }
+
+    /// The fine sums of an insert are its runs of points in one cell, each
+    /// summed from empty sums in order and then added to its cell, bit for
+    /// bit (a cell met again later in the scan takes a second run); an
+    /// insert of more points than `RUN_KEEP` gives the runs' storage back.
+    #[test]
+    fn an_insert_adds_its_runs_of_points_bit_for_bit() {
+        let mut rng = StdRng::seed_from_u64(9);
+        let mut staged = Vec::new();
+        for run in 0..150 {
+            // Run 40 holds RUN_KEEP points, all in one cell.
+            let len = if run == 40 {
+                RUN_KEEP
+            } else {
+                rng.random_range(1..8)
+            };
+            let c = Vector2::new(f64::from(run % 37) * 0.02, f64::from(run % 5) * 0.02);
+            for _ in 0..len {
+                let w = c + Vector2::new(rng.random_range(0.0..0.02), rng.random_range(0.0..0.02));
+                staged.push((CellKey::of(w, 50.0).unwrap(), w));
+            }
+        }
+        assert!(staged.len() > RUN_KEEP);
+        let mut expected: Vec<(CellKey, CellStats)> = Vec::new();
+        let mut i = 0;
+        while i < staged.len() {
+            let key = staged[i].0;
+            let mut run = CellStats::default();
+            while i < staged.len() && staged[i].0 == key {
+                run.add_point(staged[i].1 - key.center(0.02));
+                i += 1;
+            }
+            match expected.iter_mut().find(|(k, _)| *k == key) {
+                Some((_, s)) => s.merge(&run),
+                None => expected.push((key, run)),
+            }
+        }
+        let mut p = Pyramid::new(0.02, 2);
+        let changed = p.add(&staged);
+        assert_eq!(
+            changed[0],
+            expected.iter().map(|(k, _)| *k).collect::<Vec<_>>()
+        );
+        let bits = |s: &CellStats| {
+            let mut v = vec![s.count];
+            v.extend(s.sum.iter().chain(s.scatter.iter()).map(|x| x.to_bits()));
+            v
+        };
+        for (key, want) in &expected {
+            let got = p.fine().cells().get(*key).unwrap();
+            assert_eq!(bits(got), bits(want), "{key:?}");
+        }
+        assert!(
+            p.run_sums.capacity() <= RUN_KEEP,
+            "{}",
+            p.run_sums.capacity()
+        );
     }
 
     /// A pyramid given its results back returns the keys and holds the
