@@ -516,7 +516,8 @@ fn update_shaped(
     let mut sums = ChangedSums::new(cells, changed_cells.indices);
     for (n, &key) in touched.iter().enumerate() {
         let own = sums.get(n, key);
-        let kind = kinds.of(store, ancestor_of(key));
+        let at = ancestor_of(key);
+        let kind = kinds.of(store, at);
         match (own, kind) {
             (None, _) => store.remove(key),
             (Some(stats), Some(Ancestor::Shaped(slot))) => {
@@ -538,7 +539,6 @@ fn update_shaped(
         // searched when its own or one across its border is shapeless.
         let wanted_around = kind == Some(Ancestor::Unshaped) || {
             let (dx, dy) = across(key);
-            let at = ancestor_of(key);
             let mut shapeless =
                 |dx: i32, dy: i32| kinds.of(store, at.offset(dx, dy)) == Some(Ancestor::Unshaped);
             (dx != 0 && shapeless(dx, 0))

@@ -486,14 +486,9 @@ mod tests {
             changed[0],
             expected.iter().map(|(k, _)| *k).collect::<Vec<_>>()
         );
-        let bits = |s: &CellStats| {
-            let mut v = vec![s.count];
-            v.extend(s.sum.iter().chain(s.scatter.iter()).map(|x| x.to_bits()));
-            v
-        };
         for (key, want) in &expected {
             let got = p.fine().cells().get(*key).unwrap();
-            assert_eq!(bits(got), bits(want), "{key:?}");
+            assert_eq!(got.bits(), want.bits(), "{key:?}");
         }
         assert!(
             p.run_sums.capacity() <= RUN_KEEP,

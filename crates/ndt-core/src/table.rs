@@ -192,8 +192,9 @@ impl<T> CellTable<T> {
     }
 
     /// Sets the value at index `index` of the values (as
-    /// [`Cursor::index`] gave it, with no insert or removal since): no
-    /// look-up. An index out of range changes nothing.
+    /// [`Cursor::index`] gave it, with no removal since: see
+    /// [`CellTable::value`]): no look-up. An index out of range changes
+    /// nothing.
     #[inline]
     pub fn set_at(&mut self, index: u32, value: T) {
         if let Some(v) = self.values.get_mut(index as usize) {
@@ -542,7 +543,7 @@ impl<'a, T> Cursor<'a, T> {
     }
 
     /// The index of `key`'s value among the table's values (stable until
-    /// the next insert of a new key or removal), if it has one.
+    /// the next removal: a new key's value is pushed), if it has one.
     #[inline(always)]
     pub fn index(&mut self, key: CellKey) -> Option<u32> {
         let (tile, slot) = split(key);
