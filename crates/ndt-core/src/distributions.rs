@@ -36,13 +36,19 @@ pub struct DistOptions {
 
 /// The cells of one level a change of the grid touched: their keys and,
 /// when the pyramid gave them ([`crate::pyramid::Pyramid::changed_indices`]),
-/// the indices of their values among the level's sums, in the same order.
+/// the indices of their values among the level's sums, in the same order;
+/// with a shape level, the cells that changed there.
 #[derive(Debug, Clone, Copy)]
 pub struct Changed<'a> {
     /// The cells' keys.
     pub keys: &'a [CellKey],
     /// Per key, the index of its sums' value, if known.
     pub indices: Option<&'a [u32]>,
+    /// The changed cells of the shape level (empty without one): the keys'
+    /// ancestors there, each once, in the order of their first descendant
+    /// among `keys`, as [`crate::pyramid::Pyramid::add`] lists a level's
+    /// changes (each parent once, in the order of its first changed child).
+    pub ancestors: &'a [CellKey],
 }
 
 /// The distribution of every cell that has one, for one [`DistOptions`].
@@ -149,7 +155,8 @@ impl Distributions {
     /// cells `touched` gained or lost points: those cells, with fusion their 8
     /// neighbours (whose fused sums include them), and with a shape level the
     /// touched cells' ancestors (`shape`: that level, whose cells must
-    /// already include the change; the same depth as at build). An ancestor
+    /// already include the change; the same depth as at build; its changed
+    /// cells in `touched.ancestors`). An ancestor
     /// whose shape changed only in value is written once for all the cells
     /// under it ([`crate::shaped`]); one that gained or lost its shape sets
     /// every cell under it again.
@@ -461,24 +468,20 @@ fn update_shaped(
     let s = shapes.shape();
     let depth = s.depth();
     let ancestor_of = |k: CellKey| crate::pyramid::coarse_key(k, depth);
-    // The touched cells' ancestors, each once (a scan's cells come in runs
-    // under one ancestor): those whose kind changed set all their cells again.
-    // (The search's scratch set, emptied again before the search.)
-    let seen = &mut *search.seen;
+    // The touched cells' ancestors, each once, as the pyramid listed them
+    // (no look-up to meet each once): those whose kind changed set all their
+    // cells again.
+    debug_assert_eq!(
+        changed_cells.ancestors,
+        first_ancestors(touched, depth).as_slice(),
+        "the shape level's changes are the touched cells' ancestors"
+    );
     let mut changed = FxHashSet::default();
-    let mut last = None;
-    for &key in touched {
-        let at = ancestor_of(key);
-        if last != Some(at) {
-            last = Some(at);
-            if seen.insert(at)
-                && store.set_ancestor(at, shapes.next(at, || shape_of_ancestor(s, at, options)))
-            {
-                changed.insert(at);
-            }
+    for &at in changed_cells.ancestors {
+        if store.set_ancestor(at, shapes.next(at, || shape_of_ancestor(s, at, options))) {
+            changed.insert(at);
         }
     }
-    seen.clear();
     if !changed.is_empty() {
         let mut private = Vec::new();
         for (at, key, own) in s.descendants(&changed) {
@@ -556,6 +559,17 @@ fn update_shaped(
     own_distributions(cells, cell_size, options, &unshaped, |key, g| {
         store.set_own(key, g);
     });
+}
+
+/// The ancestors `depth` levels above `keys`, each once, in the order of
+/// their first descendant among `keys` (what [`Changed::ancestors`] holds;
+/// for the debug builds' check).
+fn first_ancestors(keys: &[CellKey], depth: usize) -> Vec<CellKey> {
+    let mut seen = FxHashSet::default();
+    keys.iter()
+        .map(|&k| crate::pyramid::coarse_key(k, depth))
+        .filter(|&at| seen.insert(at))
+        .collect()
 }
 
 /// The new sums of the changed cells of one level, in order ([`Changed`]):

@@ -345,10 +345,16 @@ impl NdtGrid {
         for dist in prepared.iter_mut() {
             let l = dist.level();
             if let (Some(level), Some(keys)) = (self.pyramid.level(l), touched.get(l)) {
-                let shape = shape_at(&self.pyramid, l, dist.shape_depth());
+                let depth = dist.shape_depth();
+                let shape = shape_at(&self.pyramid, l, depth);
                 let changed = Changed {
                     keys,
                     indices: self.pyramid.changed_indices(l),
+                    // Each level's changes list its cells' parents each
+                    // once, in the order of their first changed child.
+                    ancestors: shape
+                        .and_then(|_| touched.get(l + depth))
+                        .map_or(&[], Vec::as_slice),
                 };
                 Arc::make_mut(dist).update(
                     level.cells(),

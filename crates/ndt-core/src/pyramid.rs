@@ -202,7 +202,11 @@ impl Pyramid {
     /// each level is a function of the fine cells alone (the same however the
     /// points were batched, and bit for bit the same after a save and load).
     ///
-    /// Returns, per level, the keys of the cells that changed.
+    /// Returns, per level, the keys of the cells that changed, each once; on
+    /// a coarser level in the order of their first changed child on the
+    /// level below, so an ancestor's place is that of its first changed
+    /// descendant ([`crate::distributions::Changed::ancestors`] relies on
+    /// it).
     pub fn add(&mut self, staged: &[(CellKey, Vector2<f64>)]) -> Vec<Vec<CellKey>> {
         let touched = self.add_fine(staged);
         self.refresh_parents(touched)
@@ -297,7 +301,8 @@ impl Pyramid {
 
     /// Re-sums, level by level, every coarse cell above the changed fine
     /// cells `fine` from its 4 children on the level below (in a fixed order),
-    /// dropping it when they are all gone. Returns the changed keys per level.
+    /// dropping it when they are all gone. Returns the changed keys per level
+    /// (each parent once, in the order of its first changed child).
     fn refresh_parents(&mut self, fine: Vec<CellKey>) -> Vec<Vec<CellKey>> {
         let mut touched_all: Vec<Vec<CellKey>> = Vec::with_capacity(self.levels.len());
         touched_all.push(fine);
@@ -561,9 +566,25 @@ mod tests {
         }
     }
 
+    /// Each level's changed cells are the parents of the level below's, each
+    /// once, in the order of their first changed child (what the
+    /// distributions take as the touched cells' ancestors).
+    fn assert_parents_in_order(changed: &[Vec<CellKey>]) {
+        for (l, pair) in changed.windows(2).enumerate() {
+            let mut seen = std::collections::HashSet::new();
+            let parents: Vec<CellKey> = pair[0]
+                .iter()
+                .map(|&k| coarse_key(k, 1))
+                .filter(|&k| seen.insert(k))
+                .collect();
+            assert_eq!(pair[1], parents, "level {}", l + 1);
+        }
+    }
+
     /// An insert gives the indices of every level's changed cells; a
     /// removal those of the coarse levels where no cell went (a level that
-    /// lost one gives none), a deferred refresh those of the coarse levels.
+    /// lost one gives none), a deferred refresh those of the coarse levels;
+    /// and each level's changes are the parents of the level below's.
     #[test]
     fn changed_indices_point_at_the_changed_cells() {
         let mut rng = StdRng::seed_from_u64(7);
@@ -574,16 +595,19 @@ mod tests {
             let staged = random_points(&mut rng, n, 0.5);
             let changed = p.add(&staged);
             assert_changed_indices(&p, &changed, true);
+            assert_parents_in_order(&changed);
             assert!((0..4).all(|l| p.changed_indices(l).is_some()));
             p.give_back(changed);
             let gone: Vec<CellKey> = staged.iter().step_by(2).map(|(k, _)| *k).collect();
             let changed = p.remove(&gone);
             assert_changed_indices(&p, &changed, false);
+            assert_parents_in_order(&changed);
             unindexed += (1..4).filter(|&l| p.changed_indices(l).is_none()).count();
             p.give_back(changed);
             let fine = p.add_fine(&staged);
             let changed = p.refresh(&fine);
             assert_changed_indices(&p, &changed, false);
+            assert_parents_in_order(&changed);
         }
         assert!(unindexed > 0, "some removal emptied a coarse cell");
     }
