@@ -494,8 +494,8 @@ fn update_shaped(
         });
     }
     // What an ancestor is now, `None` when it changed kind (its cells are
-    // set above); the last one asked about remembered.
-    let mut kinds = AncestorKinds::new(&changed);
+    // set above) or holds no cell; the last one asked about remembered.
+    let mut kinds = AncestorKinds::new(&changed, s.cells());
     // A new distribution of their own for those without a shape, and with
     // fusion for their minority neighbours without one (a cell gone or
     // changed changes its neighbours' fused sums). A touched cell inside its
@@ -539,7 +539,9 @@ fn update_shaped(
             }
         }
         // Only cells under a shapeless ancestor are wanted: a cell is
-        // searched when its own or one across its border is shapeless.
+        // searched when its own or one across its border is shapeless (and
+        // holds cells: a touched cell on the border of empty space has no
+        // neighbours there).
         let wanted_around = kind == Some(Ancestor::Unshaped) || {
             let (dx, dy) = across(key);
             let mut shapeless =
@@ -610,11 +612,13 @@ impl<'a> ChangedSums<'a> {
 /// neighbours, and the touched cells' runs, lie under nearby ancestors.
 struct AncestorKinds<'a> {
     changed: &'a FxHashSet<CellKey>,
+    /// The shape level's sums: which ancestors hold cells.
+    top: Cursor<'a, CellStats>,
     memo: [(CellKey, Option<Ancestor>); 16],
 }
 
 impl<'a> AncestorKinds<'a> {
-    fn new(changed: &'a FxHashSet<CellKey>) -> Self {
+    fn new(changed: &'a FxHashSet<CellKey>, top: &'a CellTable<CellStats>) -> Self {
         // No ancestor index is i32::MIN (|index| < 2³⁰).
         let none = CellKey {
             ix: i32::MIN,
@@ -622,11 +626,14 @@ impl<'a> AncestorKinds<'a> {
         };
         Self {
             changed,
+            top: top.cursor(),
             memo: [(none, None); 16],
         }
     }
 
-    /// `None` for an ancestor that changed kind in this update.
+    /// `None` for an ancestor that changed kind in this update (its cells
+    /// are set from scratch) or that holds no cell (an unshaped one without
+    /// points): no cell under it is left to the update's loop.
     #[inline(always)]
     fn of(&mut self, store: &ShapedStore, at: CellKey) -> Option<Ancestor> {
         let slot = ((at.ix & 3) | (at.iy & 3) << 2) as usize;
@@ -639,7 +646,11 @@ impl<'a> AncestorKinds<'a> {
     /// [`AncestorKinds::of`] for an ancestor not remembered (out of line).
     #[inline(never)]
     fn look_up(&mut self, store: &ShapedStore, at: CellKey, slot: usize) -> Option<Ancestor> {
-        let kind = (!self.changed.contains(&at)).then(|| store.ancestor(at));
+        let kind = match store.ancestor(at) {
+            _ if self.changed.contains(&at) => None,
+            Ancestor::Unshaped if self.top.get(at).is_none() => None,
+            kind => Some(kind),
+        };
         if let Some(m) = self.memo.get_mut(slot) {
             *m = (at, kind);
         }
