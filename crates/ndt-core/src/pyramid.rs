@@ -80,8 +80,9 @@ pub struct Pyramid {
 /// A parent cell that had no value when it was met.
 const NEW_PARENT: u32 = u32::MAX;
 
-/// Runs of points ([`Pyramid::add_fine`]) whose storage a pyramid keeps
-/// between inserts (64 bytes each): a scan's, not a whole map's.
+/// Runs whose storage a pyramid keeps between updates: a scan's, not a
+/// whole map's (runs of points in one cell, [`Pyramid::add_fine`], 64 bytes
+/// each; runs of changed cells under one parent, 8 bytes each).
 const RUN_KEEP: usize = 4096;
 
 /// The key of the level-`level` cell covering fine cell `key`: an arithmetic
@@ -324,10 +325,13 @@ impl Pyramid {
                 // parent once, without a branch per child (whether a child
                 // starts a run follows the map's shapes, which no predictor
                 // learns). A write at `n` stays until a new parent moves `n`.
+                // (The storage only grows: each entry is written before it
+                // is read, so none is filled first.)
                 let runs = &mut self.runs;
                 let lower_keys = &touched_all[l - 1];
-                runs.clear();
-                runs.resize(lower_keys.len(), CellKey { ix: 0, iy: 0 });
+                if runs.len() < lower_keys.len() {
+                    runs.resize(lower_keys.len(), CellKey { ix: 0, iy: 0 });
+                }
                 let mut n = 0;
                 let mut last = None;
                 for &child in lower_keys {
@@ -338,13 +342,13 @@ impl Pyramid {
                     n += usize::from(last != Some(parent));
                     last = Some(parent);
                 }
-                runs.truncate(n);
+                let runs = runs.get(..n).unwrap_or_default();
                 // Each parent met first kept, again without a branch: the
                 // entry at `n` is written, and kept by moving `n` past it.
                 changed.resize(runs.len(), CellKey { ix: 0, iy: 0 });
                 slots.resize(runs.len(), NEW_PARENT);
                 let mut n = 0;
-                for &parent in runs.iter() {
+                for &parent in runs {
                     let (first, i) = match existing.index(parent) {
                         Some(i) => (self.stamps.first_meeting(l, i), i),
                         None => (new_parents.insert(parent), NEW_PARENT),
@@ -381,6 +385,12 @@ impl Pyramid {
             }
             self.changed.done(l, slots, indices_hold);
             touched_all.push(changed);
+        }
+        // The runs' storage of a scan's change is kept, that of a larger
+        // change's given back (as `add_fine`'s).
+        if self.runs.len() > RUN_KEEP {
+            self.runs.truncate(RUN_KEEP);
+            self.runs.shrink_to_fit();
         }
         touched_all
     }
@@ -500,6 +510,25 @@ mod tests {
             "{}",
             p.run_sums.capacity()
         );
+    }
+
+    /// A change of more fine cells than `RUN_KEEP` (a whole map at once)
+    /// gives back the storage of the parents' runs, and a smaller change
+    /// after it lists its parents alone, though the storage still holds
+    /// older runs beyond them.
+    #[test]
+    fn a_large_change_gives_the_parents_runs_back() {
+        let mut rng = StdRng::seed_from_u64(5);
+        let mut p = Pyramid::new(0.02, 3);
+        let big = random_points(&mut rng, 3 * RUN_KEEP, 5.0);
+        let changed = p.add(&big);
+        assert!(changed[0].len() > RUN_KEEP, "{}", changed[0].len());
+        assert!(p.runs.capacity() <= RUN_KEEP, "{}", p.runs.capacity());
+        for n in [RUN_KEEP, 7, 300, 1] {
+            let staged = random_points(&mut rng, n, 5.0);
+            let changed = p.add(&staged);
+            assert_parents_in_order(&changed);
+        }
     }
 
     /// A pyramid given its results back returns the keys and holds the
