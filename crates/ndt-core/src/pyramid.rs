@@ -70,7 +70,8 @@ pub struct Pyramid {
     /// The cells an insert added to the fine level (reused between updates).
     fresh: Vec<CellKey>,
     /// The parents of one level's runs of changed cells (reused between
-    /// updates).
+    /// updates; only as many entries as the level has runs are its own, the
+    /// rest are older levels' and never read).
     runs: Vec<CellKey>,
     /// An insert's runs of points in one cell, with their sums (reused
     /// between updates).
