@@ -12,7 +12,7 @@ use crate::cellmask::CellMask;
 use crate::gather;
 use crate::key::CellKey;
 use crate::moments::{self, GaussBatch, StatsBatch};
-use crate::scratch::{KeyScratch, KeySet};
+use crate::scratch::{first_touch, KeyScratch, KeySet};
 use crate::shape::{AncestorShape, Shape, ShapeMemo, ShapeReader};
 use crate::shaped::{Ancestor, ShapedCursor, ShapedStore};
 use crate::table::{CellTable, Cursor};
@@ -473,7 +473,10 @@ fn update_shaped(
     // cells again.
     debug_assert_eq!(
         changed_cells.ancestors,
-        first_ancestors(touched, depth).as_slice(),
+        first_touch(
+            touched.iter().map(|&k| ancestor_of(k)),
+            &mut KeySet::default()
+        ),
         "the shape level's changes are the touched cells' ancestors"
     );
     let mut changed = FxHashSet::default();
@@ -563,17 +566,6 @@ fn update_shaped(
     });
 }
 
-/// The ancestors `depth` levels above `keys`, each once, in the order of
-/// their first descendant among `keys` (what [`Changed::ancestors`] holds;
-/// for the debug builds' check).
-fn first_ancestors(keys: &[CellKey], depth: usize) -> Vec<CellKey> {
-    let mut seen = FxHashSet::default();
-    keys.iter()
-        .map(|&k| crate::pyramid::coarse_key(k, depth))
-        .filter(|&at| seen.insert(at))
-        .collect()
-}
-
 /// The new sums of the changed cells of one level, in order ([`Changed`]):
 /// by the index of their value where the pyramid gave it (no look-up),
 /// else looked up. The pyramid's indices hold until its next change, which
@@ -646,10 +638,13 @@ impl<'a> AncestorKinds<'a> {
     /// [`AncestorKinds::of`] for an ancestor not remembered (out of line).
     #[inline(never)]
     fn look_up(&mut self, store: &ShapedStore, at: CellKey, slot: usize) -> Option<Ancestor> {
-        let kind = match store.ancestor(at) {
-            _ if self.changed.contains(&at) => None,
-            Ancestor::Unshaped if self.top.get(at).is_none() => None,
-            kind => Some(kind),
+        let kind = if self.changed.contains(&at) {
+            None
+        } else {
+            match store.ancestor(at) {
+                Ancestor::Unshaped if self.top.get(at).is_none() => None,
+                kind => Some(kind),
+            }
         };
         if let Some(m) = self.memo.get_mut(slot) {
             *m = (at, kind);

@@ -86,6 +86,15 @@ const NEW_PARENT: u32 = u32::MAX;
 /// each; runs of changed cells under one parent, 8 bytes each).
 const RUN_KEEP: usize = 4096;
 
+/// Keeps at most [`RUN_KEEP`] runs of `runs`' storage, giving the rest
+/// back.
+fn keep_runs<T>(runs: &mut Vec<T>) {
+    if runs.len() > RUN_KEEP {
+        runs.truncate(RUN_KEEP);
+        runs.shrink_to_fit();
+    }
+}
+
 /// The key of the level-`level` cell covering fine cell `key`: an arithmetic
 /// shift, i.e. floor division by `2^level` (correct for negative indices).
 #[inline]
@@ -269,10 +278,7 @@ impl Pyramid {
         }
         // The storage of a scan's runs is kept, that of a larger insert's
         // (a whole map at once) given back.
-        if runs.len() > RUN_KEEP {
-            runs.truncate(RUN_KEEP);
-            runs.shrink_to_fit();
-        }
+        keep_runs(runs);
         // No removal here: the indices hold.
         self.changed.done(0, indices, true);
         // Only new cells change the occupancy, or can lie beyond the bounds.
@@ -389,10 +395,7 @@ impl Pyramid {
         }
         // The runs' storage of a scan's change is kept, that of a larger
         // change's given back (as `add_fine`'s).
-        if self.runs.len() > RUN_KEEP {
-            self.runs.truncate(RUN_KEEP);
-            self.runs.shrink_to_fit();
-        }
+        keep_runs(&mut self.runs);
         touched_all
     }
 }
@@ -446,6 +449,7 @@ impl Pyramid {
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
+    use crate::scratch::{first_touch, KeySet};
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
 
@@ -601,12 +605,10 @@ mod tests {
     /// distributions take as the touched cells' ancestors).
     fn assert_parents_in_order(changed: &[Vec<CellKey>]) {
         for (l, pair) in changed.windows(2).enumerate() {
-            let mut seen = std::collections::HashSet::new();
-            let parents: Vec<CellKey> = pair[0]
-                .iter()
-                .map(|&k| coarse_key(k, 1))
-                .filter(|&k| seen.insert(k))
-                .collect();
+            let parents = first_touch(
+                pair[0].iter().map(|&k| coarse_key(k, 1)),
+                &mut KeySet::default(),
+            );
             assert_eq!(pair[1], parents, "level {}", l + 1);
         }
     }
