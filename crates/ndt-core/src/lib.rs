@@ -61,6 +61,7 @@ mod staging;
 pub mod table;
 #[cfg(test)]
 mod testing;
+pub mod tiledir;
 // The integration tests' fixtures (`tests/common`) name the crate `ndt_core`;
 // unit tests that share them need the name too.
 #[cfg(test)]

@@ -4,17 +4,21 @@
 //! pyramid's sums (an insert re-sums each changed coarse cell from its 4
 //! children, which always share a tile).
 //!
-//! Cells are grouped into square tiles of [`TILE`] × [`TILE`] cells. A hash
-//! map finds a tile by its index; inside a tile a cell is a direct array
-//! access to the slot of its value in one contiguous `Vec`. Consecutive
-//! points of a scan mostly fall into the same tile, so [`Cursor`] remembers
-//! the last tile and skips the hash for them, and the 8 neighbours of the
-//! neighbour search (§IV-A(1)) are mostly in that tile too.
+//! Cells are grouped into square tiles of [`TILE`] × [`TILE`] cells. A flat
+//! directory over a rectangle holding every tile finds a tile by its index
+//! with one indexed load ([`crate::tiledir`]); a table too sparse for it
+//! (its cells spread over a large area) finds its tiles in a hash map.
+//! Inside a tile a cell is a direct array access to the slot of its value
+//! in one contiguous `Vec`. Consecutive points of a scan mostly fall into
+//! the same tile, so [`Cursor`] remembers the last tiles and skips the
+//! directory for them, and the 8 neighbours of the neighbour search
+//! (§IV-A(1)) are mostly in that tile too.
 
 use rustc_hash::FxHashMap;
 
 use crate::key::CellKey;
 use crate::parity::ParityMemo;
+use crate::tiledir::{TileDirectory, NONE};
 
 /// log2 of the tile side \[cells\].
 const TILE_BITS: i32 = 3;
@@ -79,8 +83,10 @@ pub struct CellTable<T> {
     keys: Vec<CellKey>,
     /// The tile of the last insert of each parity of the tile index, so runs
     /// of inserts in one tile, and inserts around one cell across tile
-    /// borders, skip the hash.
+    /// borders, skip the hash (with the directory off).
     inserted: ParityMemo<u32>,
+    /// The tiles by index without a hash, while the table is dense enough.
+    dir: TileDirectory,
 }
 
 /// A copy with the original's spare capacity: inserts into a clone grow
@@ -102,6 +108,7 @@ impl<T: Clone> Clone for CellTable<T> {
             values,
             keys,
             inserted: self.inserted,
+            dir: self.dir.clone(),
         }
     }
 }
@@ -134,6 +141,7 @@ impl<T> Default for CellTable<T> {
             values: Vec::new(),
             keys: Vec::new(),
             inserted: ParityMemo::new(NONE),
+            dir: TileDirectory::default(),
         }
     }
 }
@@ -161,13 +169,16 @@ impl<T> CellTable<T> {
     #[inline]
     pub fn get(&self, key: CellKey) -> Option<&T> {
         let (tile, slot) = split(key);
-        let t = *self.tiles.get(&tile)?;
+        let t = match self.dir.get(tile) {
+            Some(t) => t,
+            None => *self.tiles.get(&tile)?,
+        };
         self.value_at(t, slot)
     }
 
     #[inline]
     fn value_at(&self, tile: u32, slot: usize) -> Option<&T> {
-        let i = self.slots[tile as usize][slot];
+        let i = *self.slots.get(tile as usize)?.get(slot)?;
         if i == EMPTY {
             None
         } else {
@@ -244,6 +255,7 @@ impl<T> CellTable<T> {
         self.values.clear();
         self.keys.clear();
         self.inserted.clear();
+        self.dir.clear();
     }
 
     /// Sets the value of `key` (replacing any). Unlike
@@ -271,11 +283,24 @@ impl<T> CellTable<T> {
         }
     }
 
-    /// The tile of `key` (a new one when it has none) and its slot there.
+    /// The tile of `key` (a new one when it has none) and its slot there:
+    /// through the directory inline, any other way out of line.
+    #[inline(always)]
     fn tile_of(&mut self, key: CellKey) -> (u32, usize) {
         let (tile, slot) = split(key);
+        match self.dir.get(tile) {
+            Some(t) if t != NONE => (t, slot),
+            _ => (self.tile_not_listed(tile), slot),
+        }
+    }
+
+    /// [`CellTable::tile_of`] for a tile the directory does not give (it
+    /// is off, or the tile is new): the last inserted tile of its parity,
+    /// else through the hash, else a new tile.
+    #[inline(never)]
+    fn tile_not_listed(&mut self, tile: (i32, i32)) -> u32 {
         if let Some(t) = self.inserted.get(tile) {
-            return (t, slot);
+            return t;
         }
         let t = match self.tiles.get(&tile).copied() {
             Some(t) => t,
@@ -289,11 +314,13 @@ impl<T> CellTable<T> {
                     }
                 };
                 self.tiles.insert(tile, t);
+                let all = self.tiles.iter().map(|(&i, &t)| (i, t));
+                self.dir.set(tile, t, self.tiles.len(), all);
                 t
             }
         };
         self.inserted.set(tile, t);
-        (t, slot)
+        t
     }
 
     /// Stores `value` for `key` in the empty `slot` of tile `t`.
@@ -317,6 +344,8 @@ impl<T> CellTable<T> {
         if self.used[t as usize] == 0 {
             self.tiles.remove(&tile);
             self.inserted.forget(tile);
+            self.dir
+                .set(tile, NONE, self.tiles.len(), std::iter::empty());
             self.free_tiles.push(t);
         }
         // Keep the values contiguous: move the last one into the hole.
@@ -350,10 +379,17 @@ impl<T> CellTable<T> {
             + self.slots.capacity() * std::mem::size_of::<Tile>()
             + self.used.capacity() * 4
             + self.free_tiles.capacity() * 4
+            + self.dir.heap_bytes()
             + hash_map_bytes(
                 self.tiles.capacity(),
                 std::mem::size_of::<((i32, i32), u32)>(),
             )
+    }
+
+    /// Whether the tiles are found through the directory (else by hash).
+    #[cfg(test)]
+    fn directory_on(&self) -> bool {
+        self.dir.is_on()
     }
 
     /// A reader that remembers the last tiles it used (see [`Cursor`]).
@@ -366,14 +402,14 @@ impl<T> CellTable<T> {
     }
 }
 
-/// No tile (out of the slots' range).
-const NONE: u32 = u32::MAX;
-
 /// Reads a [`CellTable`] remembering the last tile looked up of each parity
 /// of its index (`tx mod 2`, `ty mod 2`), so runs of look-ups in one tile
-/// (a scan's consecutive points) hash once, and so do the look-ups of a
+/// (a scan's consecutive points) find it once, and so do the look-ups of a
 /// cell's neighbours (§IV-A) across tile borders: any 2 × 2 block of tiles
-/// has one tile of each parity.
+/// has one tile of each parity. A tile not remembered comes from the
+/// table's directory, or its hash map when the directory is off. (In the
+/// matcher's loop the remembered tile is nearly always the one; a
+/// directory read first would cost it instructions and no time.)
 #[derive(Debug)]
 pub struct Cursor<'a, T> {
     table: &'a CellTable<T>,
@@ -390,12 +426,19 @@ impl<'a, T> Cursor<'a, T> {
     }
 
     /// The tile of index `tile` ([`NONE`] where the table has none), through
-    /// the remembered tiles.
+    /// the remembered tiles, else the directory, else the hash.
     #[inline(always)]
     fn tile_index(&mut self, tile: (i32, i32)) -> u32 {
         match self.tiles.get(tile) {
             Some(t) => t,
-            None => self.find_tile(tile),
+            None => {
+                let t = match self.table.dir.get(tile) {
+                    Some(t) => t,
+                    None => self.find_tile(tile),
+                };
+                self.tiles.set(tile, t);
+                t
+            }
         }
     }
 
@@ -554,13 +597,12 @@ impl<'a, T> Cursor<'a, T> {
         }
     }
 
-    /// The hashed look-up of a tile not remembered (kept out of line, so
-    /// the common path inlines into the matcher's loop).
+    /// The hashed look-up of a tile not remembered, with the directory off
+    /// (kept out of line, so the common path inlines into the matcher's
+    /// loop).
     #[inline(never)]
-    fn find_tile(&mut self, tile: (i32, i32)) -> u32 {
-        let t = self.table.tiles.get(&tile).copied().unwrap_or(NONE);
-        self.tiles.set(tile, t);
-        t
+    fn find_tile(&self, tile: (i32, i32)) -> u32 {
+        self.table.tiles.get(&tile).copied().unwrap_or(NONE)
     }
 }
 
@@ -589,6 +631,80 @@ mod tests {
                 (Some(&4), Some(&5), 2)
             );
         }
+    }
+
+    /// Every read of `table` around `center` (±10 cells: single cells, a
+    /// cursor, blocks and quads) as `naive` holds it.
+    fn assert_reads_as(table: &CellTable<i32>, naive: &HashMap<CellKey, i32>, center: CellKey) {
+        let mut cursor = table.cursor();
+        let none = -1;
+        for dx in -10..10 {
+            for dy in -10..10 {
+                let key = center.offset(dx, dy);
+                let want = naive.get(&key);
+                assert_eq!((table.get(key), cursor.get(key)), (want, want), "{key:?}");
+                let block = cursor.block3(key, &none);
+                for (i, got) in block.iter().enumerate() {
+                    let n = key.offset((i % 3) as i32 - 1, (i / 3) as i32 - 1);
+                    assert_eq!(**got, *naive.get(&n).unwrap_or(&none), "{key:?} {i}");
+                }
+                let quad = cursor.quad(key, &none);
+                for (i, got) in quad.iter().enumerate() {
+                    let child = CellKey {
+                        ix: 2 * key.ix + (i % 2) as i32,
+                        iy: 2 * key.iy + (i / 2) as i32,
+                    };
+                    assert_eq!(**got, *naive.get(&child).unwrap_or(&none), "{key:?} {i}");
+                }
+            }
+        }
+    }
+
+    /// Two clusters of cells far apart make the table too sparse for its
+    /// directory: its tiles are then found by hash, with the same reads and
+    /// writes; filled in between, it takes the directory again.
+    #[test]
+    fn a_table_too_sparse_for_its_directory_reads_the_same() {
+        let mut table = CellTable::default();
+        let mut naive = HashMap::new();
+        let (near, far) = (CellKey { ix: 0, iy: 0 }, CellKey { ix: 40_000, iy: 0 });
+        let mut x: u64 = 3;
+        let mut step = 0;
+        let mut churn =
+            |table: &mut CellTable<i32>, naive: &mut HashMap<CellKey, i32>, c: CellKey| {
+                for _ in 0..2_000 {
+                    x = x
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    let key = c.offset(((x >> 33) % 17) as i32 - 8, ((x >> 13) % 17) as i32 - 8);
+                    step += 1;
+                    if (x >> 60) < 5 {
+                        assert_eq!(table.remove(key), naive.remove(&key));
+                    } else {
+                        assert_eq!(table.replace(key, step), naive.insert(key, step));
+                    }
+                }
+            };
+        churn(&mut table, &mut naive, near);
+        assert!(table.directory_on());
+        assert_reads_as(&table, &naive, near);
+        churn(&mut table, &mut naive, far);
+        assert!(!table.directory_on());
+        churn(&mut table, &mut naive, near);
+        assert_reads_as(&table, &naive, near);
+        assert_reads_as(&table, &naive, far);
+        // A cell in every tile from one cluster to the other.
+        for ix in (0..40_000).step_by(TILE as usize) {
+            let key = CellKey { ix, iy: 24 };
+            *table.get_or_default(key) += 1;
+            *naive.entry(key).or_insert(0) += 1;
+        }
+        assert!(table.directory_on());
+        churn(&mut table, &mut naive, far);
+        for c in [near, far, CellKey { ix: 20_000, iy: 24 }] {
+            assert_reads_as(&table, &naive, c);
+        }
+        assert_eq!(table.len(), naive.len());
     }
 
     #[test]
