@@ -327,7 +327,7 @@ impl Pyramid {
             let (lower, upper) = (&lower_levels[l - 1], &mut upper_levels[0]);
             {
                 self.stamps.prepare(l, upper.cells.len());
-                let mut existing = upper.cells.cursor();
+                let mut existing = upper.cells.direct_cursor();
                 // Changed children come in runs under one parent: each run's
                 // parent once, without a branch per child (whether a child
                 // starts a run follows the map's shapes, which no predictor
@@ -369,7 +369,7 @@ impl Pyramid {
                 slots.truncate(n);
             }
             // The 4 children of a parent share a tile: one tile look-up at most.
-            let mut children = lower.cells.cursor();
+            let mut children = lower.cells.direct_cursor();
             let none = CellStats::default();
             // The values' indices hold until a removal moves one.
             let mut indices_hold = true;

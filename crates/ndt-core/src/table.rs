@@ -400,6 +400,18 @@ impl<T> CellTable<T> {
             tiles: ParityMemo::new(NONE),
         }
     }
+
+    /// A reader that finds every tile through the directory (while it is
+    /// on), remembering none: for look-ups that cross tile borders too
+    /// irregularly for the remembered tiles to be predicted (a changed
+    /// level's parents, in [`crate::pyramid`]).
+    #[inline]
+    pub fn direct_cursor(&self) -> Cursor<'_, T, false> {
+        Cursor {
+            table: self,
+            tiles: ParityMemo::new(NONE),
+        }
+    }
 }
 
 /// Reads a [`CellTable`] remembering the last tile looked up of each parity
@@ -409,15 +421,17 @@ impl<T> CellTable<T> {
 /// has one tile of each parity. A tile not remembered comes from the
 /// table's directory, or its hash map when the directory is off. (In the
 /// matcher's loop the remembered tile is nearly always the one; a
-/// directory read first would cost it instructions and no time.)
+/// directory read first would cost it instructions and no time.) With
+/// `REMEMBER` false ([`CellTable::direct_cursor`]) the directory is read
+/// first.
 #[derive(Debug)]
-pub struct Cursor<'a, T> {
+pub struct Cursor<'a, T, const REMEMBER: bool = true> {
     table: &'a CellTable<T>,
     /// Per parity: the tile remembered ([`NONE`]: the table has none there).
     tiles: ParityMemo<u32>,
 }
 
-impl<'a, T> Cursor<'a, T> {
+impl<'a, T, const REMEMBER: bool> Cursor<'a, T, REMEMBER> {
     /// The value of `key`, if any (as [`CellTable::get`]).
     #[inline(always)]
     pub fn get(&mut self, key: CellKey) -> Option<&'a T> {
@@ -429,6 +443,11 @@ impl<'a, T> Cursor<'a, T> {
     /// the remembered tiles, else the directory, else the hash.
     #[inline(always)]
     fn tile_index(&mut self, tile: (i32, i32)) -> u32 {
+        if !REMEMBER {
+            if let Some(t) = self.table.dir.get(tile) {
+                return t;
+            }
+        }
         match self.tiles.get(tile) {
             Some(t) => t,
             None => {
@@ -636,13 +655,25 @@ mod tests {
     /// Every read of `table` around `center` (±10 cells: single cells, a
     /// cursor, blocks and quads) as `naive` holds it.
     fn assert_reads_as(table: &CellTable<i32>, naive: &HashMap<CellKey, i32>, center: CellKey) {
-        let mut cursor = table.cursor();
+        assert_cursor_reads_as(table, table.cursor(), naive, center);
+        assert_cursor_reads_as(table, table.direct_cursor(), naive, center);
+    }
+
+    /// [`assert_reads_as`] with one cursor (remembering tiles or not).
+    fn assert_cursor_reads_as<const R: bool>(
+        table: &CellTable<i32>,
+        mut cursor: Cursor<'_, i32, R>,
+        naive: &HashMap<CellKey, i32>,
+        center: CellKey,
+    ) {
         let none = -1;
         for dx in -10..10 {
             for dy in -10..10 {
                 let key = center.offset(dx, dy);
                 let want = naive.get(&key);
                 assert_eq!((table.get(key), cursor.get(key)), (want, want), "{key:?}");
+                let index = cursor.index(key).and_then(|i| table.value(i));
+                assert_eq!(index, want, "{key:?}");
                 let block = cursor.block3(key, &none);
                 for (i, got) in block.iter().enumerate() {
                     let n = key.offset((i % 3) as i32 - 1, (i / 3) as i32 - 1);
