@@ -92,8 +92,10 @@ impl TileDirectory {
         }
         // A new rectangle, or a new tile while off: laid out anew when dense
         // enough.
-        let size = self.w as usize * self.h as usize;
-        if size <= SMALL.max(SPARSE.saturating_mul(tiles)) {
+        // In u64: a rectangle across the whole key range has 2⁵⁶ words.
+        let size = u64::from(self.w) * u64::from(self.h);
+        let allowed = SMALL.max(SPARSE.saturating_mul(tiles)) as u64;
+        if size <= allowed {
             self.lay_out(all);
         } else {
             self.words = Vec::new();
@@ -265,5 +267,23 @@ mod tests {
         check(&dir, &naive);
         dir.clear();
         assert!(dir.is_on() && dir.get((0, 0)) == Some(NONE) && dir.heap_bytes() == 0);
+    }
+
+    /// Tiles at the two ends of the key range (|cell index| < 2³⁰, so tile
+    /// indices within ±2²⁷): the rectangle spans them without overflow and
+    /// stays off; the hash answers.
+    #[test]
+    fn tiles_at_the_ends_of_the_key_range_leave_it_off() {
+        let mut dir = TileDirectory::default();
+        let mut naive = HashMap::new();
+        let end = (crate::key::MAX_INDEX >> 3) - 1;
+        for (t, index) in (0..).zip([(0, 0), (end, end), (-end, -end), (-end, end)]) {
+            add(&mut dir, &mut naive, index, t);
+        }
+        assert!(!dir.is_on());
+        assert_eq!(
+            (dir.get((end, end)), dir.get((0, 1)), dir.heap_bytes()),
+            (None, None, 0)
+        );
     }
 }
