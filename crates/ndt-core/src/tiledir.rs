@@ -76,18 +76,17 @@ impl TileDirectory {
         tiles: usize,
         all: impl Iterator<Item = ((i32, i32), u32)>,
     ) {
-        let inside = self.contains(index);
-        if inside || t == NONE {
-            if let Some(i) = self.word(index) {
-                if let Some(w) = self.words.get_mut(i) {
-                    *w = t;
-                }
-                return;
+        if let Some(i) = self.word(index) {
+            if let Some(w) = self.words.get_mut(i) {
+                *w = t;
             }
-            if t == NONE {
-                return;
-            }
-        } else {
+            return;
+        }
+        // Off, or outside: nothing to forget.
+        if t == NONE {
+            return;
+        }
+        if !self.contains(index) {
             self.grow(index);
         }
         // A new rectangle, or a new tile while off: laid out anew when dense
@@ -114,8 +113,9 @@ impl TileDirectory {
     fn word(&self, index: (i32, i32)) -> Option<usize> {
         let dx = index.0.wrapping_sub(self.x0) as u32;
         let dy = index.1.wrapping_sub(self.y0) as u32;
-        let i = dy as usize * self.w as usize + dx as usize;
-        (dx < self.w && dy < self.h && i < self.words.len()).then_some(i)
+        (dx < self.w && dy < self.h)
+            .then(|| dy as usize * self.w as usize + dx as usize)
+            .filter(|&i| i < self.words.len())
     }
 
     /// Grows the rectangle to hold `index`, doubling each side that must
