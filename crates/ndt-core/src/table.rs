@@ -666,7 +666,6 @@ mod tests {
         naive: &HashMap<CellKey, i32>,
         center: CellKey,
     ) {
-        let none = -1;
         for dx in -10..10 {
             for dy in -10..10 {
                 let key = center.offset(dx, dy);
@@ -674,20 +673,31 @@ mod tests {
                 assert_eq!((table.get(key), cursor.get(key)), (want, want), "{key:?}");
                 let index = cursor.index(key).and_then(|i| table.value(i));
                 assert_eq!(index, want, "{key:?}");
-                let block = cursor.block3(key, &none);
-                for (i, got) in block.iter().enumerate() {
-                    let n = key.offset((i % 3) as i32 - 1, (i / 3) as i32 - 1);
-                    assert_eq!(**got, *naive.get(&n).unwrap_or(&none), "{key:?} {i}");
-                }
-                let quad = cursor.quad(key, &none);
-                for (i, got) in quad.iter().enumerate() {
-                    let child = CellKey {
-                        ix: 2 * key.ix + (i % 2) as i32,
-                        iy: 2 * key.iy + (i / 2) as i32,
-                    };
-                    assert_eq!(**got, *naive.get(&child).unwrap_or(&none), "{key:?} {i}");
-                }
+                assert_block_and_quad(&mut cursor, naive, key);
             }
+        }
+    }
+
+    /// The 3 × 3 block around `key` and the 4 cells under it (as the level
+    /// below's parent) read as `naive` holds them (-1: no value).
+    fn assert_block_and_quad<const R: bool>(
+        cursor: &mut Cursor<'_, i32, R>,
+        naive: &HashMap<CellKey, i32>,
+        key: CellKey,
+    ) {
+        let none = -1;
+        let block = cursor.block3(key, &none);
+        for (i, got) in block.iter().enumerate() {
+            let n = key.offset((i % 3) as i32 - 1, (i / 3) as i32 - 1);
+            assert_eq!(**got, *naive.get(&n).unwrap_or(&none), "{key:?} {i}");
+        }
+        let quad = cursor.quad(key, &none);
+        for (i, got) in quad.iter().enumerate() {
+            let child = CellKey {
+                ix: 2 * key.ix + (i % 2) as i32,
+                iy: 2 * key.iy + (i / 2) as i32,
+            };
+            assert_eq!(**got, *naive.get(&child).unwrap_or(&none), "{key:?} {i}");
         }
     }
 
@@ -777,7 +787,6 @@ mod tests {
         // Rings, blocks and quads read what single look-ups read, inside
         // tiles, across their borders and where no tile is.
         let mut blocks = table.cursor();
-        let none = -1;
         for ix in -22..22 {
             for iy in -20..20 {
                 let key = CellKey { ix, iy };
@@ -788,19 +797,7 @@ mod tests {
                     .filter_map(|&(dx, dy)| naive.get(&key.offset(dx, dy)).copied())
                     .collect();
                 assert_eq!(ring, want, "{key:?}");
-                let block = blocks.block3(key, &none);
-                for (i, got) in block.iter().enumerate() {
-                    let n = key.offset((i % 3) as i32 - 1, (i / 3) as i32 - 1);
-                    assert_eq!(**got, *naive.get(&n).unwrap_or(&none), "{key:?} {i}");
-                }
-                let quad = blocks.quad(key, &none);
-                for (i, got) in quad.iter().enumerate() {
-                    let child = CellKey {
-                        ix: 2 * ix + (i % 2) as i32,
-                        iy: 2 * iy + (i / 2) as i32,
-                    };
-                    assert_eq!(**got, *naive.get(&child).unwrap_or(&none), "{key:?} {i}");
-                }
+                assert_block_and_quad(&mut blocks, &naive, key);
             }
         }
         // Equal to a table of the same entries inserted in another order.
