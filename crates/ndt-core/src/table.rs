@@ -284,42 +284,48 @@ impl<T> CellTable<T> {
     }
 
     /// The tile of `key` (a new one when it has none) and its slot there:
-    /// through the directory inline, any other way out of line.
+    /// through the directory inline (which, on, lists every tile: one it
+    /// does not have is new), any other way out of line.
     #[inline(always)]
     fn tile_of(&mut self, key: CellKey) -> (u32, usize) {
         let (tile, slot) = split(key);
         match self.dir.get(tile) {
-            Some(t) if t != NONE => (t, slot),
-            _ => (self.tile_not_listed(tile), slot),
+            Some(NONE) => (self.new_tile(tile), slot),
+            Some(t) => (t, slot),
+            None => (self.tile_by_hash(tile), slot),
         }
     }
 
-    /// [`CellTable::tile_of`] for a tile the directory does not give (it
-    /// is off, or the tile is new): the last inserted tile of its parity,
-    /// else through the hash, else a new tile.
+    /// [`CellTable::tile_of`] with the directory off: the last inserted
+    /// tile of its parity, else through the hash, else a new tile.
     #[inline(never)]
-    fn tile_not_listed(&mut self, tile: (i32, i32)) -> u32 {
+    fn tile_by_hash(&mut self, tile: (i32, i32)) -> u32 {
         if let Some(t) = self.inserted.get(tile) {
             return t;
         }
         let t = match self.tiles.get(&tile).copied() {
             Some(t) => t,
-            None => {
-                let t = match self.free_tiles.pop() {
-                    Some(t) => t,
-                    None => {
-                        self.slots.push([EMPTY; (TILE * TILE) as usize]);
-                        self.used.push(0);
-                        (self.slots.len() - 1) as u32
-                    }
-                };
-                self.tiles.insert(tile, t);
-                let all = self.tiles.iter().map(|(&i, &t)| (i, t));
-                self.dir.set(tile, t, self.tiles.len(), all);
-                t
-            }
+            None => self.new_tile(tile),
         };
         self.inserted.set(tile, t);
+        t
+    }
+
+    /// A tile for index `tile`, which has none (an emptied tile's storage
+    /// if there is one), entered in the hash and the directory.
+    #[inline(never)]
+    fn new_tile(&mut self, tile: (i32, i32)) -> u32 {
+        let t = match self.free_tiles.pop() {
+            Some(t) => t,
+            None => {
+                self.slots.push([EMPTY; (TILE * TILE) as usize]);
+                self.used.push(0);
+                (self.slots.len() - 1) as u32
+            }
+        };
+        self.tiles.insert(tile, t);
+        let all = self.tiles.iter().map(|(&i, &t)| (i, t));
+        self.dir.set(tile, t, self.tiles.len(), all);
         t
     }
 

@@ -33,6 +33,8 @@ pub struct TileDirectory {
     /// directory is off.
     words: Vec<u32>,
     /// The answer outside the rectangle: `Some(NONE)` while on, `None` off.
+    /// (Off is also "no words, a rectangle": kept as the answer itself, so
+    /// a look-up outside costs no test of it.)
     outside: Option<u32>,
 }
 
@@ -55,8 +57,7 @@ impl TileDirectory {
     #[inline(always)]
     pub fn get(&self, index: (i32, i32)) -> Option<u32> {
         // Off, no word is kept: inside the rectangle too, `None`.
-        let dx = index.0.wrapping_sub(self.x0) as u32;
-        let dy = index.1.wrapping_sub(self.y0) as u32;
+        let (dx, dy) = self.offset(index);
         if dx < self.w && dy < self.h {
             self.words
                 .get(dy as usize * self.w as usize + dx as usize)
@@ -102,18 +103,26 @@ impl TileDirectory {
         }
     }
 
+    /// `index` from the rectangle's lowest corner (below it: wrapped to
+    /// beyond any side).
+    #[inline(always)]
+    fn offset(&self, index: (i32, i32)) -> (u32, u32) {
+        (
+            index.0.wrapping_sub(self.x0) as u32,
+            index.1.wrapping_sub(self.y0) as u32,
+        )
+    }
+
     /// Whether `index` lies in the rectangle.
     fn contains(&self, index: (i32, i32)) -> bool {
-        let dx = index.0.wrapping_sub(self.x0) as u32;
-        let dy = index.1.wrapping_sub(self.y0) as u32;
+        let (dx, dy) = self.offset(index);
         dx < self.w && dy < self.h
     }
 
     /// The word of `index` while on and inside.
     fn word(&self, index: (i32, i32)) -> Option<usize> {
-        let dx = index.0.wrapping_sub(self.x0) as u32;
-        let dy = index.1.wrapping_sub(self.y0) as u32;
-        (dx < self.w && dy < self.h)
+        let (dx, dy) = self.offset(index);
+        self.contains(index)
             .then(|| dy as usize * self.w as usize + dx as usize)
             .filter(|&i| i < self.words.len())
     }
