@@ -262,6 +262,11 @@ impl<T> CellTable<T> {
     /// [`CellTable::replace`], the value it replaces is not read: on a table
     /// larger than the processor's caches that read is a miss the write
     /// would otherwise wait for.
+    ///
+    /// Inline: a shaped update writes each touched cell's mean with it (about
+    /// 650 calls an insert), and the call cost more than the write
+    /// (BENCHMARK.md, "Speed", session 43).
+    #[inline(always)]
     pub fn insert(&mut self, key: CellKey, value: T) {
         let (t, slot) = self.tile_of(key);
         match self.slots[t as usize][slot] {
