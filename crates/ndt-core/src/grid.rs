@@ -444,18 +444,21 @@ impl NdtGrid {
 }
 
 /// Levels from `level` up to the first level whose cells are at least
-/// `shape_cell` \[m\] (see [`crate::shape`]); 0 when `shape_cell` is 0 or no
-/// coarser level is that large.
+/// `shape_cell` \[m\] (see [`crate::shape`]); 0 when `shape_cell` is 0,
+/// when `level`'s own cells are that large (only cells finer than
+/// `shape_cell` take an ancestor's shape, as `MatchOptions::shape_cell`
+/// says), or when no coarser level is.
 fn shape_depth(pyramid: &Pyramid, level: usize, shape_cell: f64) -> usize {
-    if shape_cell <= 0.0 {
+    let at_least = |l: usize| {
+        pyramid
+            .level(l)
+            .is_some_and(|lv| lv.cell_size() >= shape_cell * (1.0 - 1e-9))
+    };
+    if shape_cell <= 0.0 || at_least(level) {
         return 0;
     }
     (level + 1..pyramid.len())
-        .find(|&l| {
-            pyramid
-                .level(l)
-                .is_some_and(|lv| lv.cell_size() >= shape_cell * (1.0 - 1e-9))
-        })
+        .find(|&l| at_least(l))
         .map_or(0, |l| l - level)
 }
 
@@ -490,5 +493,55 @@ pub(crate) fn check_points(what: &'static str, points: &[[f64; 2]]) -> Result<()
             },
         }),
         None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// Options of the default match with shape cell `shape_cell`.
+    fn options(shape_cell: f64) -> DistOptions {
+        DistOptions {
+            expansion: 10.0,
+            fuse_minority: true,
+            sigma_floor: 0.02,
+            shape_cell,
+        }
+    }
+
+    #[test]
+    fn only_cells_finer_than_the_shape_cell_take_an_ancestors_shape() {
+        let mut grid = NdtGrid::new(0.02).unwrap();
+        // Two walls and a few lone points: shaped, unshaped and minority cells
+        // on every level.
+        let mut points: Vec<[f64; 2]> = (0..200)
+            .map(|i| [-1.5 + 0.015 * f64::from(i), 0.4 + 0.002 * f64::from(i)])
+            .collect();
+        points.extend((0..120).map(|i| [1.2, -1.0 + 0.017 * f64::from(i)]));
+        points.extend([[-2.0, -2.0], [2.5, 1.9], [0.0, -2.4]]);
+        grid.insert(&points, Pose2::new(0.1, -0.2, 0.3)).unwrap();
+        // 2, 4, 8 and 16 cm take the 32 cm ancestors' shapes; 32 and 64 cm
+        // cells are not finer than 32 cm and keep their own.
+        let depths: Vec<usize> = (0..grid.levels())
+            .map(|l| grid.distributions(l, options(0.32)).unwrap().shape_depth())
+            .collect();
+        assert_eq!(depths, [4, 3, 2, 1, 0, 0]);
+        // With a 30 cm shape cell the 16 cm level still takes the 32 cm one's.
+        let depths: Vec<usize> = (0..grid.levels())
+            .map(|l| grid.distributions(l, options(0.3)).unwrap().shape_depth())
+            .collect();
+        assert_eq!(depths, [4, 3, 2, 1, 0, 0]);
+        // The 32 cm level's distributions are the paper's (shapes off), bit
+        // for bit, for every cell.
+        let level = grid.level(4).unwrap();
+        let own = Distributions::build(level.cells(), level.cell_size(), 4, options(0.0), None);
+        let kept = grid.distributions(4, options(0.32)).unwrap();
+        assert!(!own.is_empty());
+        assert_eq!(kept.len(), own.len());
+        for (key, _) in level.cells().iter() {
+            assert_eq!(kept.get(key), own.get(key), "{key:?}");
+        }
     }
 }
