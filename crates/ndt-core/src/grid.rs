@@ -514,8 +514,8 @@ mod tests {
     #[test]
     fn only_cells_finer_than_the_shape_cell_take_an_ancestors_shape() {
         let mut grid = NdtGrid::new(0.02).unwrap();
-        // Two walls and a few lone points: shaped, unshaped and minority cells
-        // on every level.
+        // Two walls, and three lone points: cells of fewer than 3 points
+        // (fused, §IV-A(3)) under ancestors without a shape.
         let mut points: Vec<[f64; 2]> = (0..200)
             .map(|i| [-1.5 + 0.015 * f64::from(i), 0.4 + 0.002 * f64::from(i)])
             .collect();
