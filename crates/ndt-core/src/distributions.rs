@@ -600,13 +600,15 @@ impl<'a> ChangedSums<'a> {
 }
 
 /// The kinds of ancestors during one shaped update (fixed by then),
-/// remembered in 16 slots by the ancestor index's low bits: a cell's
-/// neighbours, and the touched cells' runs, lie under nearby ancestors.
+/// remembered in 64 slots by the ancestor index's low 3 bits on each axis:
+/// a cell's neighbours, and the touched cells' runs, lie under nearby
+/// ancestors. Each miss is a hash probe: 245 an insert of `insert_case`
+/// with 16 slots, 223 with 64 (BENCHMARK.md, "Speed", session 43).
 struct AncestorKinds<'a> {
     changed: &'a FxHashSet<CellKey>,
     /// The shape level's sums: which ancestors hold cells.
     top: Cursor<'a, CellStats>,
-    memo: [(CellKey, Option<Ancestor>); 16],
+    memo: [(CellKey, Option<Ancestor>); 64],
 }
 
 impl<'a> AncestorKinds<'a> {
@@ -619,7 +621,7 @@ impl<'a> AncestorKinds<'a> {
         Self {
             changed,
             top: top.cursor(),
-            memo: [(none, None); 16],
+            memo: [(none, None); 64],
         }
     }
 
@@ -628,7 +630,7 @@ impl<'a> AncestorKinds<'a> {
     /// points): no cell under it is left to the update's loop.
     #[inline(always)]
     fn of(&mut self, store: &ShapedStore, at: CellKey) -> Option<Ancestor> {
-        let slot = ((at.ix & 3) | (at.iy & 3) << 2) as usize;
+        let slot = ((at.ix & 7) | (at.iy & 7) << 3) as usize;
         match self.memo.get(slot) {
             Some(&(k, kind)) if k == at => kind,
             _ => self.look_up(store, at, slot),
