@@ -169,11 +169,24 @@ impl<T> CellTable<T> {
     #[inline]
     pub fn get(&self, key: CellKey) -> Option<&T> {
         let (tile, slot) = split(key);
-        let t = match self.dir.get(tile) {
+        self.value_at(self.find_tile(tile), slot)
+    }
+
+    /// The tile of index `tile` ([`NONE`] where the table has none): from
+    /// the directory inline, from the hash out of line (the directory off),
+    /// so the common path inlines into the matcher's loop.
+    #[inline(always)]
+    fn find_tile(&self, tile: (i32, i32)) -> u32 {
+        match self.dir.get(tile) {
             Some(t) => t,
-            None => *self.tiles.get(&tile)?,
-        };
-        self.value_at(t, slot)
+            None => self.hashed_tile(tile),
+        }
+    }
+
+    /// [`CellTable::find_tile`] with the directory off.
+    #[inline(never)]
+    fn hashed_tile(&self, tile: (i32, i32)) -> u32 {
+        self.tiles.get(&tile).copied().unwrap_or(NONE)
     }
 
     #[inline]
@@ -462,10 +475,7 @@ impl<'a, T, const REMEMBER: bool> Cursor<'a, T, REMEMBER> {
         match self.tiles.get(tile) {
             Some(t) => t,
             None => {
-                let t = match self.table.dir.get(tile) {
-                    Some(t) => t,
-                    None => self.find_tile(tile),
-                };
+                let t = self.table.find_tile(tile);
                 self.tiles.set(tile, t);
                 t
             }
@@ -625,14 +635,6 @@ impl<'a, T, const REMEMBER: bool> Cursor<'a, T, REMEMBER> {
             None | Some(EMPTY) => None,
             Some(i) => Some(i),
         }
-    }
-
-    /// The hashed look-up of a tile not remembered, with the directory off
-    /// (kept out of line, so the common path inlines into the matcher's
-    /// loop).
-    #[inline(never)]
-    fn find_tile(&self, tile: (i32, i32)) -> u32 {
-        self.table.tiles.get(&tile).copied().unwrap_or(NONE)
     }
 }
 

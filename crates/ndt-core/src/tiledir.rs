@@ -122,7 +122,7 @@ impl TileDirectory {
     /// The word of `index` while on and inside.
     fn word(&self, index: (i32, i32)) -> Option<usize> {
         let (dx, dy) = self.offset(index);
-        self.contains(index)
+        (dx < self.w && dy < self.h)
             .then(|| dy as usize * self.w as usize + dx as usize)
             .filter(|&i| i < self.words.len())
     }
