@@ -511,6 +511,25 @@ def urg_log_times(args: argparse.Namespace) -> dict[str, Any]:
     return res
 
 
+def no_cases_reason(key: str) -> str:
+    """Why the case set ``key`` came out empty: its log is absent, or (for the URG sets,
+    whose reference is the consensus of small_gicp GICP and Open3D ICP) a judge is."""
+    if key.startswith("urg") and URG_LOG.exists():
+        names = [p.name for p in all_peers()]
+        missing = [
+            judge
+            for judge, prefix in (("small_gicp GICP", "small_gicp"), ("Open3D ICP", "Open3D"))
+            if not any(n.startswith(prefix) for n in names)
+        ]
+        if missing:
+            return (
+                f"its reference needs two judges and {' and '.join(missing)} did not import: "
+                "see the 'peer skipped' line above"
+            )
+        return "the judges agreed on no candidate"
+    return "data absent"
+
+
 def section_match(args: argparse.Namespace) -> dict[str, Any]:
     """Section 1."""
     out("\n## 1. Match: ours against the peers, same scans, same starts\n")
@@ -558,7 +577,7 @@ def section_match(args: argparse.Namespace) -> dict[str, Any]:
     for key, title, make in sets:
         cases = make()
         if not cases:
-            out(f"\n{title}: no cases (data absent).")
+            out(f"\n{title}: no cases ({no_cases_reason(key)}).")
             continue
         runs = run_cases(cases, methods, args.starts, rng, key)
         res[key] = match_table(title, cases, runs)
