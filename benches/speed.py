@@ -1334,11 +1334,12 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         mid: list[int | None] | None = None,
     ) -> None:
         """Matches ``part`` into ``sink``; its start and end into ``span``, and the CPU
-        the thread is on half-way through into ``mid`` (one read of /proc, about 14 µs)."""
-        half = len(part) // 2 if mid is not None else -1
+        the thread is on at its first match and half-way through into ``mid`` (one read
+        of /proc each, about 14 µs)."""
+        reads = (0, len(part) // 2) if mid is not None else ()
         start = time.perf_counter()
         for i, (p, g) in enumerate(part):
-            if i == half and mid is not None:
+            if i in reads and mid is not None:
                 mid.append(pinned.current_cpu())
             sink.append(grid.match(p, g).pose)
         if span is not None:
@@ -1360,11 +1361,12 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
 
     def two(
         jobs: Sequence[tuple[F64, F64]] = jobs, read_cpu: bool = True
-    ) -> tuple[float, float, list[F64], float, float, bool | None]:
+    ) -> tuple[float, float, list[F64], float, float, bool | None, bool | None]:
         """Wall and CPU time, the poses in job order, the second thread's start after
         the clock's (s), the share of the wall time both threads were matching, and
-        whether the two threads were on one CPU half-way through their halves (``None``
-        where the CPU cannot be read, or with ``read_cpu`` false)."""
+        whether the two threads were on one CPU half-way through their halves and at
+        their first matches (``None`` where the CPU cannot be read, or with
+        ``read_cpu`` false)."""
         sinks: list[list[F64]] = [[], []]
         spans: list[list[float]] = [[], []]
         mids: list[list[int | None]] = [[], []]
@@ -1382,9 +1384,12 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             dt, cpu = time.perf_counter() - t0, time.process_time() - c0
         late = max(sp[0] for sp in spans)
         both = max(0.0, min(sp[1] for sp in spans) - late)
-        at = [m[0] if m else None for m in mids]
-        shared = None if None in at else at[0] == at[1]
-        return dt, cpu, in_job_order(sinks), late - t0, both / dt, shared
+
+        def on_one_cpu(k: int) -> bool | None:
+            at = [m[k] if len(m) > k else None for m in mids]
+            return None if None in at else at[0] == at[1]
+
+        return dt, cpu, in_job_order(sinks), late - t0, both / dt, on_one_cpu(1), on_one_cpu(0)
 
     # Control: the same one-vs-two-thread test on hashlib, which releases the GIL on large
     # buffers; it tells what parallelism the machine had free, whatever ndtgrid does.
@@ -1463,6 +1468,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     singles, doubles, cpu1, cpu2 = [], [], [], []
     lates, overlaps = [], []
     shared: list[bool | None] = []
+    shared_first: list[bool | None] = []
     bundle_1, bundle_2 = [], []
     pin_1, pin_2, pin_lates, pin_cpu1, pin_cpu2 = [], [], [], [], []
     many_1, many_2, many_cpu = [], [], []
@@ -1471,7 +1477,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         for rep in progress(range(args.thread_reps), "threads"):
             t1, c1, r1 = one()
             base = r1
-            t2, c2, r2, late, overlap, one_cpu = two()
+            t2, c2, r2, late, overlap, one_cpu, one_cpu_first = two()
             singles.append(t1)
             doubles.append(t2)
             cpu1.append(c1 / t1)
@@ -1479,10 +1485,11 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             lates.append(late)
             overlaps.append(overlap)
             shared.append(one_cpu)
+            shared_first.append(one_cpu_first)
             same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
             controls.append(control())
             t1, _, r1 = one(bundles)
-            t2, _, r2, _, _, _ = two(bundles, read_cpu=False)
+            t2, _, r2, *_ = two(bundles, read_cpu=False)
             bundle_1.append(t1)
             bundle_2.append(t2)
             same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
@@ -1536,12 +1543,18 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     def median_or_dash(xs: list[float]) -> str:
         return f"{float(np.median(xs)):.2f}×" if xs else "–"
 
+    # ... and at their first matches: the kernel places a thread when it starts it.
+    first = [(r, sh) for r, sh in zip(per_run["unpinned"], shared_first) if sh is not None]
+    first_together = [r for r, sh in first if sh]
+    first_apart = [r for r, sh in first if not sh]
     cpu_text = (
-        "Half-way through its half of each two-thread run, each thread read the CPU it "
-        "was on (`current_cpu` in `benches/pinned.py`: one read of `/proc` per thread and "
-        "run, inside the timed run): the two were on one vCPU in "
-        f"{len(together)} of {len(known)} runs; median ratio {median_or_dash(together)} in "
-        f"those, {median_or_dash(apart)} in the others."
+        "At its first match and half-way through its half of each two-thread run, each "
+        "thread read the CPU it was on (`current_cpu` in `benches/pinned.py`: one read of "
+        "`/proc` per thread each time, inside the timed run): the two were on one vCPU at "
+        f"their first matches in {len(first_together)} of {len(first)} runs (median ratio "
+        f"{median_or_dash(first_together)} in those, {median_or_dash(first_apart)} in the "
+        f"others), and half-way through in {len(together)} of {len(known)} runs (median "
+        f"ratio {median_or_dash(together)} in those, {median_or_dash(apart)} in the others)."
         if known
         else "Where the threads ran was not read (no `/proc/self/task`)."
     )
@@ -1674,6 +1687,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "many_ratio": many_ratio,
         "many_ratio_best": many_best,
         "one_cpu_runs": len(together) if known else None,
+        "one_cpu_first_runs": len(first_together) if first else None,
         "cpu_read_runs": len(known),
     }
 
@@ -1872,7 +1886,8 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
             + (
                 ""
                 if t.get("one_cpu_runs") is None
-                else f"; both threads on one vCPU half-way through in {t['one_cpu_runs']} "
+                else "; both threads on one vCPU at their first matches in "
+                f"{t['one_cpu_first_runs']} and half-way through in {t['one_cpu_runs']} "
                 f"of {t['cpu_read_runs']} runs"
             )
             + ")",
