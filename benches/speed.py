@@ -1334,8 +1334,10 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         mid: list[int | None] | None = None,
     ) -> None:
         """Matches ``part`` into ``sink``; its start and end into ``span``, and the CPU
-        the thread is on at its first match and half-way through into ``mid`` (one read
-        of /proc each, about 14 µs)."""
+        the thread is on at its first match and half-way through into ``mid``
+        (``pinned.current_cpu``: glibc's ``sched_getcpu``, about 0.1 µs, the GIL kept).
+        A read of /proc at the first match instead, about 14 µs, lowered the ratio itself
+        (BENCHMARK.md, "Speed", session 44)."""
         reads = (0, len(part) // 2) if mid is not None else ()
         start = time.perf_counter()
         for i, (p, g) in enumerate(part):
@@ -1549,8 +1551,8 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     first_apart = [r for r, sh in first if not sh]
     cpu_text = (
         "At its first match and half-way through its half of each two-thread run, each "
-        "thread read the CPU it was on (`current_cpu` in `benches/pinned.py`: one read of "
-        "`/proc` per thread each time, inside the timed run): the two were on one vCPU at "
+        "thread read the CPU it was on (`current_cpu` in `benches/pinned.py`: glibc's "
+        "`sched_getcpu`, inside the timed run): the two were on one vCPU at "
         f"their first matches in {len(first_together)} of {len(first)} runs (median ratio "
         f"{median_or_dash(first_together)} in those, {median_or_dash(first_apart)} in the "
         f"others), and half-way through in {len(together)} of {len(known)} runs (median "

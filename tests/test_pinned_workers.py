@@ -46,8 +46,23 @@ def test_each_worker_runs_on_its_own_cpu_only() -> None:
     assert len(os.sched_getaffinity(0)) >= 2
 
 
+#: ``current_cpu``'s two readers: glibc's ``sched_getcpu``, and ``/proc`` without it.
+READERS = pytest.mark.parametrize("reader", ["sched_getcpu", "proc"])
+
+
+def use_reader(reader: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    if reader == "proc":
+        monkeypatch.setattr(pinned, "_SCHED_GETCPU", None)
+    elif pinned._SCHED_GETCPU is None:
+        pytest.skip("the C library has no sched_getcpu")
+
+
 @needs_two
-def test_current_cpu_is_the_cpu_a_pinned_worker_runs_on() -> None:
+@READERS
+def test_current_cpu_is_the_cpu_a_pinned_worker_runs_on(
+    reader: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    use_reader(reader, monkeypatch)
     seen: list[tuple[int, int | None]] = []
     lock = threading.Lock()
 
@@ -63,9 +78,13 @@ def test_current_cpu_is_the_cpu_a_pinned_worker_runs_on() -> None:
         assert cpu == CPUS[i]
 
 
-def test_current_cpu_is_an_allowed_cpu_or_none_without_proc() -> None:
+@READERS
+def test_current_cpu_is_an_allowed_cpu_or_none_without_proc(
+    reader: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    use_reader(reader, monkeypatch)
     cpu = pinned.current_cpu()
-    if not os.path.exists(f"/proc/self/task/{threading.get_native_id()}/stat"):
+    if reader == "proc" and not os.path.exists(f"/proc/self/task/{threading.get_native_id()}/stat"):
         assert cpu is None
     elif hasattr(os, "sched_getaffinity"):
         assert cpu in os.sched_getaffinity(0)
