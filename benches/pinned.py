@@ -53,7 +53,7 @@ _SCHED_GETCPU = _libc_sched_getcpu()
 def current_cpu() -> int | None:
     """The CPU the calling thread is running on, or ``None`` where that cannot be read.
 
-    glibc's ``sched_getcpu`` (no system call on x86-64 Linux: about 1 µs from Python), or
+    glibc's ``sched_getcpu`` (no system call on x86-64 Linux: about 0.1 µs from Python), or
     else field 39 (``processor``) of ``/proc/self/task/<tid>/stat`` (about 14 µs); read by
     the thread itself, it is the CPU the thread runs on at that moment. The thread
     section of ``benches/speed.py`` reads it per thread at the first match and half-way

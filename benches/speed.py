@@ -1558,7 +1558,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         f"others), and half-way through in {len(together)} of {len(known)} runs (median "
         f"ratio {median_or_dash(together)} in those, {median_or_dash(apart)} in the others)."
         if known
-        else "Where the threads ran was not read (no `/proc/self/task`)."
+        else "Where the threads ran could not be read (neither `sched_getcpu` nor `/proc`)."
     )
     # match_many against the faster one-thread baseline too (its own, and the loop's).
     mm1, mm2 = n / np.median(many_1), n / np.median(many_2)
