@@ -40,7 +40,7 @@ def _libc_sched_getcpu() -> Callable[[], int] | None:
     thread), or ``None`` where the C library has no such function."""
     try:
         fn = ctypes.PyDLL(None).sched_getcpu
-    except (OSError, AttributeError):
+    except (OSError, AttributeError, TypeError):  # TypeError: no PyDLL(None) on Windows
         return None
     fn.restype = ctypes.c_int
     fn.argtypes = []

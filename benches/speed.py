@@ -511,11 +511,11 @@ def urg_log_times(args: argparse.Namespace) -> dict[str, Any]:
     return res
 
 
-def no_cases_reason(key: str) -> str:
+def no_cases_reason(key: str, names: Sequence[str]) -> str:
     """Why the case set ``key`` came out empty: its log is absent, or (for the URG sets,
-    whose reference is the consensus of small_gicp GICP and Open3D ICP) a judge is."""
+    whose reference is the consensus of small_gicp GICP and Open3D ICP) a judge is;
+    ``names``: the methods that imported."""
     if key.startswith("urg") and URG_LOG.exists():
-        names = [p.name for p in all_peers()]
         missing = [
             judge
             for judge, prefix in (("small_gicp GICP", "small_gicp"), ("Open3D ICP", "Open3D"))
@@ -577,7 +577,7 @@ def section_match(args: argparse.Namespace) -> dict[str, Any]:
     for key, title, make in sets:
         cases = make()
         if not cases:
-            out(f"\n{title}: no cases ({no_cases_reason(key)}).")
+            out(f"\n{title}: no cases ({no_cases_reason(key, [m.name for m in methods])}).")
             continue
         runs = run_cases(cases, methods, args.starts, rng, key)
         res[key] = match_table(title, cases, runs)
