@@ -1547,6 +1547,9 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
 
     # ... and at their first matches: the kernel places a thread when it starts it.
     first = [(r, sh) for r, sh in zip(per_run["unpinned"], shared_first) if sh is not None]
+    per_run["unpinned_first_one_cpu"] = [
+        r if sh else math.nan for r, sh in zip(per_run["unpinned"], shared_first)
+    ]
     first_together = [r for r, sh in first if sh]
     first_apart = [r for r, sh in first if not sh]
     cpu_text = (

@@ -79,24 +79,27 @@ def plot_sweeps(res: dict[str, Any], path: Path) -> Path | None:
 def plot_threads(runs: dict[str, list[float]], path: Path) -> Path | None:
     """The thread section's runs as a PNG (skipped without matplotlib): each run's
     ratio (one thread's time over two threads' right after it) for the unpinned threads
-    (marked where both were on one vCPU half-way through) and the pinned ones,
+    (ringed where both were on one vCPU at their first matches, dotted where they were
+    half-way through; ``nan`` elsewhere in those two lists) and the pinned ones,
     ``match_many`` and the two GIL-free controls; when the later thread began. Its
     path, or ``None`` without matplotlib."""
     plt = pyplot()
     if plt is None:
         return None
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.8))
-    for key, marker, label in (
-        ("unpinned", "o", "two threads started per run"),
-        ("unpinned_one_cpu", "k.", "… on one vCPU half-way through"),
-        ("pinned", "s", "two pinned workers"),
-        ("sha", "x", "control: SHA-256 (GIL released)"),
-        ("bundles", "+", "control: 20-scan bundles"),
-        ("many", "D", "match_many, every core / one thread"),
+    ring = {"color": "k", "mfc": "none", "ms": 11, "mew": 1.2}  # keeps the colour cycle
+    for key, marker, label, style in (
+        ("unpinned", "o", "two threads started per run", {}),
+        ("unpinned_first_one_cpu", "o", "… on one vCPU at their first matches", ring),
+        ("unpinned_one_cpu", "k.", "… on one vCPU half-way through", {}),
+        ("pinned", "s", "two pinned workers", {}),
+        ("sha", "x", "control: SHA-256 (GIL released)", {}),
+        ("bundles", "+", "control: 20-scan bundles", {}),
+        ("many", "D", "match_many, every core / one thread", {}),
     ):
         ys = runs.get(key, [])
         if ys:
-            a.plot(np.arange(1, len(ys) + 1), ys, marker, label=label, alpha=0.85)
+            a.plot(np.arange(1, len(ys) + 1), ys, marker, label=label, alpha=0.85, **style)
     a.axhline(1.7, color="k", lw=0.8, ls="--", label="target 1.7×")
     a.axhline(2.0, color="0.6", lw=0.8)
     a.set_xlabel("run (one- and two-thread runs alternate)")

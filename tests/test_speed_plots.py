@@ -106,3 +106,26 @@ def test_the_picture_is_written(tmp_path: Path) -> None:
     assert int.from_bytes(header[20:24], "big") == 1100
     assert plots.plot_peers({"threads": {}}, tmp_path / "none.png", "a machine") is None
     assert not (tmp_path / "none.png").exists()
+
+
+def test_the_thread_picture_is_written(tmp_path: Path) -> None:
+    pytest.importorskip("matplotlib", reason="the picture needs matplotlib (the plot extra)")
+    nan = math.nan
+    runs = {
+        "unpinned": [1.8, 1.3, 1.75],
+        # Ringed and dotted only where the two threads shared a vCPU; nan elsewhere.
+        "unpinned_first_one_cpu": [nan, 1.3, nan],
+        "unpinned_one_cpu": [nan, nan, nan],
+        "pinned": [1.85, 1.84, 1.86],
+        "sha": [1.7, 1.6, 1.72],
+        "many": [1.9, 1.88, 1.91],
+        "late_unpinned": [4e-4, 3.5e-3, 0.0],
+        "late_pinned": [4e-5, 3e-5, 5e-5],
+    }
+    path = tmp_path / "img" / "threads.png"
+    assert plots.plot_threads(runs, path) == path.resolve()
+    header = path.read_bytes()[:24]
+    assert header[:8] == b"\x89PNG\r\n\x1a\n"
+    # figsize 11 x 4.8 inches at 110 dpi.
+    assert int.from_bytes(header[16:20], "big") == 1210
+    assert int.from_bytes(header[20:24], "big") == 528
