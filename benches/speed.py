@@ -1534,31 +1534,34 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "bundles": list(np.divide(bundle_1, bundle_2)),
         "many": list(np.divide(many_1, many_2)),
     }
-    # The unpinned runs by where the kernel had the two threads half-way through.
-    known = [(r, sh) for r, sh in zip(per_run["unpinned"], shared) if sh is not None]
-    together = [r for r, sh in known if sh]
-    apart = [r for r, sh in known if not sh]
-    per_run["unpinned_one_cpu"] = [
-        r if sh else math.nan for r, sh in zip(per_run["unpinned"], shared)
-    ]
+
+    def by_place(flags: list[bool | None]) -> tuple[list[float], list[float], int, list[float]]:
+        """The unpinned runs' ratios where the two threads were on one vCPU (``flags``
+        true) and where they were not, how many runs were read, and the ratios for the
+        picture (``nan`` where the threads were apart or not read)."""
+        pairs = list(zip(per_run["unpinned"], flags))
+        return (
+            [r for r, sh in pairs if sh],
+            [r for r, sh in pairs if sh is False],
+            sum(sh is not None for _, sh in pairs),
+            [r if sh else math.nan for r, sh in pairs],
+        )
+
+    # The unpinned runs by where the kernel had the two threads half-way through ...
+    together, apart, known, per_run["unpinned_one_cpu"] = by_place(shared)
+    # ... and at their first matches: the kernel places a thread when it starts it.
+    first_together, first_apart, first, per_run["unpinned_first_one_cpu"] = by_place(shared_first)
 
     def median_or_dash(xs: list[float]) -> str:
         return f"{float(np.median(xs)):.2f}×" if xs else "–"
 
-    # ... and at their first matches: the kernel places a thread when it starts it.
-    first = [(r, sh) for r, sh in zip(per_run["unpinned"], shared_first) if sh is not None]
-    per_run["unpinned_first_one_cpu"] = [
-        r if sh else math.nan for r, sh in zip(per_run["unpinned"], shared_first)
-    ]
-    first_together = [r for r, sh in first if sh]
-    first_apart = [r for r, sh in first if not sh]
     cpu_text = (
         "At its first match and half-way through its half of each two-thread run, each "
         "thread read the CPU it was on (`current_cpu` in `benches/pinned.py`: glibc's "
         "`sched_getcpu`, inside the timed run): the two were on one vCPU at "
-        f"their first matches in {len(first_together)} of {len(first)} runs (median ratio "
+        f"their first matches in {len(first_together)} of {first} runs (median ratio "
         f"{median_or_dash(first_together)} in those, {median_or_dash(first_apart)} in the "
-        f"others), and half-way through in {len(together)} of {len(known)} runs (median "
+        f"others), and half-way through in {len(together)} of {known} runs (median "
         f"ratio {median_or_dash(together)} in those, {median_or_dash(apart)} in the others)."
         if known
         else "Where the threads ran could not be read (neither `sched_getcpu` nor `/proc`)."
@@ -1693,7 +1696,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "many_ratio_best": many_best,
         "one_cpu_runs": len(together) if known else None,
         "one_cpu_first_runs": len(first_together) if first else None,
-        "cpu_read_runs": len(known),
+        "cpu_read_runs": known,
     }
 
 
