@@ -54,6 +54,14 @@ RESULTS: dict[str, dict[str, Any]] = {
 }
 
 
+def png_size(path: Path) -> tuple[int, int]:
+    """Width and height of the PNG at ``path`` (from its IHDR chunk), after checking its
+    signature."""
+    header = path.read_bytes()[:24]
+    assert header[:8] == b"\x89PNG\r\n\x1a\n"
+    return int.from_bytes(header[16:20], "big"), int.from_bytes(header[20:24], "big")
+
+
 def test_bars_are_the_tables_rows_in_order() -> None:
     bars = plots.peer_bars(RESULTS)
     match = bars["match"]
@@ -99,11 +107,8 @@ def test_the_picture_is_written(tmp_path: Path) -> None:
     pytest.importorskip("matplotlib", reason="the picture needs matplotlib (the plot extra)")
     path = tmp_path / "img" / "peers.png"
     assert plots.plot_peers(RESULTS, path, "a machine") == path.resolve()
-    header = path.read_bytes()[:24]
-    assert header[:8] == b"\x89PNG\r\n\x1a\n"
     # figsize 13 x 10 inches at 110 dpi.
-    assert int.from_bytes(header[16:20], "big") == 1430
-    assert int.from_bytes(header[20:24], "big") == 1100
+    assert png_size(path) == (1430, 1100)
     assert plots.plot_peers({"threads": {}}, tmp_path / "none.png", "a machine") is None
     assert not (tmp_path / "none.png").exists()
 
@@ -124,8 +129,5 @@ def test_the_thread_picture_is_written(tmp_path: Path) -> None:
     }
     path = tmp_path / "img" / "threads.png"
     assert plots.plot_threads(runs, path) == path.resolve()
-    header = path.read_bytes()[:24]
-    assert header[:8] == b"\x89PNG\r\n\x1a\n"
     # figsize 11 x 4.8 inches at 110 dpi.
-    assert int.from_bytes(header[16:20], "big") == 1210
-    assert int.from_bytes(header[20:24], "big") == 528
+    assert png_size(path) == (1210, 528)
