@@ -103,6 +103,10 @@ INTEL_INDEX = REAL / "benchmark-scans-split" / "intel__intel-corrected__index.cs
 INTEL_CORRECTED = REAL / "radish-gfs-corrected" / "intel-corrected.log.gz"
 # Scans merged into one for the thread section's second control.
 THREAD_BUNDLE = 20
+# s: a two-thread run whose second thread's first match began this long after the clock
+# counts as started late (BENCHMARK.md, "Speed", session 46: such runs had a median
+# ratio of 1.45 against 1.78).
+LATE_START = 1e-3
 
 SECTIONS = ("match", "insert", "odometry", "sweeps", "threads", "memory")
 CELL = 0.02  # m: our grid, the paper's 2 cm
@@ -1536,9 +1540,10 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     }
 
     def by_place(flags: list[bool | None]) -> tuple[list[float], list[float], int, list[float]]:
-        """The unpinned runs' ratios where the two threads were on one vCPU (``flags``
-        true) and where they were not, how many runs were read, and the ratios for the
-        picture (``nan`` where the threads were apart or not read)."""
+        """The unpinned runs' ratios where ``flags`` is true (the two threads on one
+        vCPU, or the second one late) and where it is false, how many runs have a flag
+        (``None``: not read), and the ratios for the picture (``nan`` where the flag is
+        false or ``None``)."""
         pairs = list(zip(per_run["unpinned"], flags))
         return (
             [r for r, sh in pairs if sh],
@@ -1551,6 +1556,8 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     together, apart, known, per_run["unpinned_one_cpu"] = by_place(shared)
     # ... and at their first matches: the kernel places a thread when it starts it.
     first_together, first_apart, first, per_run["unpinned_first_one_cpu"] = by_place(shared_first)
+    # ... and by when the second thread's first match began.
+    late_runs, early_runs, *_ = by_place([x >= LATE_START for x in lates])
 
     def median_or_dash(xs: list[float]) -> str:
         return f"{float(np.median(xs)):.2f}×" if xs else "–"
@@ -1637,7 +1644,10 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             "new thread needs the GIL, and the busy first thread that hands it over may "
             "get it woken on its own vCPU: see the pinned rows); both threads were matching during "
             f"{', '.join(f'{100 * x:.0f}' for x in overlaps)} % of the run (the rest: one "
-            "thread started late or finished early). " + cpu_text,
+            "thread started late or finished early). The second thread began "
+            f"{1e3 * LATE_START:.0f} ms or more after the clock in {len(late_runs)} of "
+            f"{len(lates)} runs (median ratio {median_or_dash(late_runs)} in those, "
+            f"{median_or_dash(early_runs)} in the others). " + cpu_text,
             "",
             "Control, run after each pair of runs: SHA-256 of a 1 MiB buffer (`hashlib` "
             "releases the GIL), 128 hashes on one thread against 64 on each of two: "
@@ -1697,6 +1707,8 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "one_cpu_runs": len(together) if known else None,
         "one_cpu_first_runs": len(first_together) if first else None,
         "cpu_read_runs": known,
+        "late_runs": len(late_runs),
+        "runs": len(lates),
     }
 
 
@@ -1898,7 +1910,8 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
                 f"{t['one_cpu_first_runs']} and half-way through in {t['one_cpu_runs']} "
                 f"of {t['cpu_read_runs']} runs"
             )
-            + ")",
+            + f"; the second thread {1e3 * LATE_START:.0f} ms or more late in "
+            f"{t['late_runs']} of {t['runs']} runs)",
             t["ratio"] >= 1.7,
         )
         pr = t.get("pinned_ratio", math.nan)
