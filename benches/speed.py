@@ -1692,6 +1692,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
                     "late_pinned": pin_lates,
                 },
                 Path(args.plot_threads),
+                late_start=LATE_START,
             )
         )
     return {

@@ -76,13 +76,16 @@ def plot_sweeps(res: dict[str, Any], path: Path) -> Path | None:
     )
 
 
-def plot_threads(runs: dict[str, list[float]], path: Path) -> Path | None:
+def plot_threads(
+    runs: dict[str, list[float]], path: Path, late_start: float | None = None
+) -> Path | None:
     """The thread section's runs as a PNG (skipped without matplotlib): each run's
     ratio (one thread's time over two threads' right after it) for the unpinned threads
     (ringed where both were on one vCPU at their first matches, dotted where they were
     half-way through; ``nan`` elsewhere in those two lists) and the pinned ones,
-    ``match_many`` and the two GIL-free controls; when the later thread began. Its
-    path, or ``None`` without matplotlib."""
+    ``match_many`` and the two GIL-free controls; when the later thread began, with a
+    line at ``late_start`` (s), where the section splits its runs into late and not.
+    Its path, or ``None`` without matplotlib."""
     plt = pyplot()
     if plt is None:
         return None
@@ -115,6 +118,10 @@ def plot_threads(runs: dict[str, list[float]], path: Path) -> Path | None:
         if ys:
             b.plot(np.arange(1, len(ys) + 1), 1e3 * np.maximum(ys, 1e-6), marker, label=label)
     b.axhline(4.0, color="k", lw=0.8, ls="--", label="scheduler tick (HZ = 250)")
+    if late_start is not None:
+        b.axhline(
+            1e3 * late_start, color="0.5", lw=0.8, ls=":", label="late start (speed.py's split)"
+        )
     b.set_yscale("log")
     b.set_xlabel("run")
     b.set_ylabel("later thread's first match began [ms]")

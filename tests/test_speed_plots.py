@@ -128,6 +128,6 @@ def test_the_thread_picture_is_written(tmp_path: Path) -> None:
         "late_pinned": [4e-5, 3e-5, 5e-5],
     }
     path = tmp_path / "img" / "threads.png"
-    assert plots.plot_threads(runs, path) == path.resolve()
+    assert plots.plot_threads(runs, path, late_start=1e-3) == path.resolve()
     # figsize 11 x 4.8 inches at 110 dpi.
     assert png_size(path) == (1210, 528)
