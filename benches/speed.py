@@ -1539,7 +1539,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "many": list(np.divide(many_1, many_2)),
     }
 
-    def by_place(flags: list[bool | None]) -> tuple[list[float], list[float], int, list[float]]:
+    def split_by(flags: list[bool | None]) -> tuple[list[float], list[float], int, list[float]]:
         """The unpinned runs' ratios where ``flags`` is true (the two threads on one
         vCPU, or the second one late) and where it is false, how many runs have a flag
         (``None``: not read), and the ratios for the picture (``nan`` where the flag is
@@ -1553,11 +1553,11 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         )
 
     # The unpinned runs by where the kernel had the two threads half-way through ...
-    together, apart, known, per_run["unpinned_one_cpu"] = by_place(shared)
+    together, apart, known, per_run["unpinned_one_cpu"] = split_by(shared)
     # ... and at their first matches: the kernel places a thread when it starts it.
-    first_together, first_apart, first, per_run["unpinned_first_one_cpu"] = by_place(shared_first)
+    first_together, first_apart, first, per_run["unpinned_first_one_cpu"] = split_by(shared_first)
     # ... and by when the second thread's first match began.
-    late_runs, early_runs, *_ = by_place([x >= LATE_START for x in lates])
+    late_runs, early_runs, *_ = split_by([x >= LATE_START for x in lates])
 
     def median_or_dash(xs: list[float]) -> str:
         return f"{float(np.median(xs)):.2f}×" if xs else "–"
