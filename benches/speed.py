@@ -181,6 +181,23 @@ def ratio(a: float, b: float) -> str:
     return f"{a / b:.2f}×"
 
 
+def plain(value: Any) -> Any:
+    """``value`` as what strict JSON holds: dicts with string keys, lists for tuples and
+    arrays, Python numbers for NumPy's, fields for dataclasses, ``None`` for NaN and
+    infinities (``--json``)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return plain(dataclasses.asdict(value))
+    if isinstance(value, dict):
+        return {str(k): plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [plain(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
 def rss_kib() -> tuple[int, int]:
     """(VmRSS, VmHWM) of this process [KiB] from ``/proc/self/status`` (0 if absent)."""
     now = peak = 0
@@ -1710,6 +1727,13 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "cpu_read_runs": known,
         "late_runs": len(late_runs),
         "runs": len(lates),
+        # Each two-thread run, in order, for --json: the ratios (per_run), the second
+        # thread's start after the clock (s), and whether the two threads were on one
+        # vCPU at their first matches and half-way through (None: not read).
+        "per_run": per_run,
+        "late_s": lates,
+        "one_cpu_first": shared_first,
+        "one_cpu_half": shared,
     }
 
 
@@ -1979,6 +2003,11 @@ def main() -> int:
         help="picture of sections 1-3, ours against the peers (default "
         "docs/img/speed_peers.png; none with --quick unless given)",
     )
+    ap.add_argument(
+        "--json",
+        help="also write every section's results (the thread section's run by run) as "
+        "JSON to this path",
+    )
     ap.add_argument("--intel-child", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--one-thread", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--poses-only", action="store_true", help=argparse.SUPPRESS)
@@ -2051,6 +2080,12 @@ def main() -> int:
         out("\n## Ours against the peers, in one picture")
         plotted(speed_plots.plot_peers(res, Path(args.plot_peers), datasets.machine()))
     targets(res)
+    if args.json:
+        doc = {"machine": datasets.machine() + dirty(), "argv": sys.argv[1:], "sections": res}
+        path = Path(args.json)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(plain(doc), indent=1, allow_nan=False) + "\n")
+        out(f"\nResults as JSON: `{path}`.")
     total = time.perf_counter() - start
     out(f"\nWhole run: {total / 60:.1f} min; load average at the end {os.getloadavg()[0]:.2f}.")
     return 0

@@ -1,0 +1,82 @@
+"""``benches/speed.py --json``: every section's results as strict JSON, the thread
+section's run by run, agreeing with what the run prints."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ._benches import BENCHES, load_bench
+from ._data import require_real
+
+speed = load_bench("speed")
+
+
+@dataclass
+class _Row:
+    name: str
+    seconds: float
+    poses: np.ndarray
+
+
+def test_plain_gives_what_strict_json_holds() -> None:
+    value = {
+        1: (np.float64(0.5), np.int64(3), math.nan),
+        "row": _Row("a", math.inf, np.array([[1.0, 2.0]])),
+        "flags": [True, None, np.bool_(False)],
+        "text": "x",
+    }
+    assert speed.plain(value) == {
+        "1": [0.5, 3, None],
+        "row": {"name": "a", "seconds": None, "poses": [[1.0, 2.0]]},
+        "flags": [True, None, False],
+        "text": "x",
+    }
+    # NumPy's scalars come back as Python's, so json needs no default.
+    assert type(speed.plain(np.float32(0.25))) is float
+    json.dumps(speed.plain(value), allow_nan=False)
+
+
+def test_the_thread_section_as_json(tmp_path: Path) -> None:
+    require_real("radish-gfs-corrected/intel-corrected.log.gz")
+    path = tmp_path / "out" / "speed.json"
+    proc = subprocess.run(
+        [
+            *(sys.executable, str(BENCHES / "speed.py")),
+            *("--quick", "--sections", "threads", "--json", str(path)),
+        ],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    data = json.loads(path.read_text())
+    assert "commit" in data["machine"]
+    assert data["argv"][-2:] == ["--json", str(path)]
+    assert list(data["sections"]) == ["threads"]
+    t = data["sections"]["threads"]
+    # --quick: three one- and two-thread runs, each with its ratio, start and CPUs.
+    runs = t["runs"]
+    assert runs == 3
+    for key in ("unpinned", "bundles", "many"):
+        assert len(t["per_run"][key]) == runs
+    # Pinned workers need two CPUs; without them their ratio is NaN, null in the JSON.
+    pinned = t["pinned_ratio"] is not None
+    assert len(t["per_run"]["pinned"]) == (runs if pinned else 0)
+    assert len(t["late_s"]) == len(t["one_cpu_first"]) == len(t["one_cpu_half"]) == runs
+    assert t["late_runs"] == sum(x >= speed.LATE_START for x in t["late_s"])
+    # The printed targets row says what the JSON holds.
+    times = "\N{MULTIPLICATION SIGN}"
+    row = re.search(
+        rf"\| two threads ≥ 1\.7{times} one \(threads started[^|]*\| ([\d.]+){times}", proc.stdout
+    )
+    assert row is not None
+    assert row.group(1) == f"{t['ratio']:.2f}"
+    assert f"late in {t['late_runs']} of {runs} runs)" in proc.stdout
+    assert f"Results as JSON: `{path}`." in proc.stdout
