@@ -105,7 +105,7 @@ INTEL_CORRECTED = REAL / "radish-gfs-corrected" / "intel-corrected.log.gz"
 THREAD_BUNDLE = 20
 # s: a two-thread run whose second thread's first match began this long after the clock
 # counts as started late (BENCHMARK.md, "Speed", session 46: such runs had a median
-# ratio of 1.45 against 1.78).
+# ratio of 1.46 against 1.78).
 LATE_START = 1e-3
 
 SECTIONS = ("match", "insert", "odometry", "sweeps", "threads", "memory")
