@@ -181,16 +181,13 @@ def ratio(a: float, b: float) -> str:
     return f"{a / b:.2f}×"
 
 
-def plain(value: Any) -> Any:
+def json_ready(value: Any) -> Any:
     """``value`` as what strict JSON holds: dicts with string keys, lists for tuples and
-    arrays, Python numbers for NumPy's, fields for dataclasses, ``None`` for NaN and
-    infinities (``--json``)."""
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return plain(dataclasses.asdict(value))
+    arrays, Python numbers for NumPy's, ``None`` for NaN and infinities (``--json``)."""
     if isinstance(value, dict):
-        return {str(k): plain(v) for k, v in value.items()}
+        return {str(k): json_ready(v) for k, v in value.items()}
     if isinstance(value, (list, tuple, np.ndarray)):
-        return [plain(v) for v in value]
+        return [json_ready(v) for v in value]
     if isinstance(value, np.generic):
         value = value.item()
     if isinstance(value, float) and not math.isfinite(value):
@@ -1726,11 +1723,11 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "one_cpu_first_runs": len(first_together) if first else None,
         "cpu_read_runs": known,
         "late_runs": len(late_runs),
-        "runs": len(lates),
-        # Each two-thread run, in order, for --json: the ratios (per_run), the second
+        # Each two-thread run, in order, for --json: the ratios (per_run; the picture's
+        # lists of them by place are left out, the flags below give them), the second
         # thread's start after the clock (s), and whether the two threads were on one
         # vCPU at their first matches and half-way through (None: not read).
-        "per_run": per_run,
+        "per_run": {k: per_run[k] for k in ("unpinned", "pinned", "bundles", "many")},
         "late_s": lates,
         "one_cpu_first": shared_first,
         "one_cpu_half": shared,
@@ -1936,7 +1933,7 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
                 f"of {t['cpu_read_runs']} runs"
             )
             + f"; the second thread {1e3 * LATE_START:.0f} ms or more late in "
-            f"{t['late_runs']} of {t['runs']} runs)",
+            f"{t['late_runs']} of {len(t['late_s'])} runs)",
             t["ratio"] >= 1.7,
         )
         pr = t.get("pinned_ratio", math.nan)
@@ -2084,7 +2081,7 @@ def main() -> int:
         doc = {"machine": datasets.machine() + dirty(), "argv": sys.argv[1:], "sections": res}
         path = Path(args.json)
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps(plain(doc), indent=1, allow_nan=False) + "\n")
+        path.write_text(json.dumps(json_ready(doc), indent=1, allow_nan=False) + "\n")
         out(f"\nResults as JSON: `{path}`.")
     total = time.perf_counter() - start
     out(f"\nWhole run: {total / 60:.1f} min; load average at the end {os.getloadavg()[0]:.2f}.")
