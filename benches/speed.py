@@ -195,6 +195,24 @@ def json_ready(value: Any) -> Any:
     return value
 
 
+def write_json(path: Path, sections: dict[str, dict[str, Any]], complete: bool) -> None:
+    """The sections run so far as ``--json``'s document at ``path``: the machine, the
+    command line, ``complete`` (false until every section asked for has run and the
+    targets are judged) and the sections. Written to a file beside ``path`` and renamed
+    over it, so a reader never sees half a document."""
+    doc = {
+        "machine": datasets.machine() + dirty(),
+        "argv": sys.argv[1:],
+        "complete": complete,
+        "sections": sections,
+    }
+    text = json.dumps(json_ready(doc), indent=1, allow_nan=False) + "\n"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".part")
+    tmp.write_text(text)
+    tmp.replace(path)
+
+
 def rss_kib() -> tuple[int, int]:
     """(VmRSS, VmHWM) of this process [KiB] from ``/proc/self/status`` (0 if absent)."""
     now = peak = 0
@@ -2003,7 +2021,7 @@ def main() -> int:
     ap.add_argument(
         "--json",
         help="also write every section's results (the thread section's run by run) as "
-        "JSON to this path",
+        'JSON to this path, after each section ("complete": true once all have run)',
     )
     ap.add_argument("--intel-child", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--one-thread", action="store_true", help=argparse.SUPPRESS)
@@ -2067,22 +2085,23 @@ def main() -> int:
         "memory": section_memory,
     }
     res: dict[str, dict[str, Any]] = {}
+    json_path = Path(args.json) if args.json else None
     for name in SECTIONS:
         if name in args.sections:
             t0 = time.perf_counter()
             gc.collect()
             res[name] = runners[name](args)
             log(f"section {name}: {time.perf_counter() - t0:.0f} s")
+            if json_path is not None:
+                # After each section, so a run stopped part-way keeps what it measured.
+                write_json(json_path, res, complete=False)
     if args.plot_peers and res.keys() & {"match", "insert", "odometry"}:
         out("\n## Ours against the peers, in one picture")
         plotted(speed_plots.plot_peers(res, Path(args.plot_peers), datasets.machine()))
     targets(res)
-    if args.json:
-        doc = {"machine": datasets.machine() + dirty(), "argv": sys.argv[1:], "sections": res}
-        path = Path(args.json)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps(json_ready(doc), indent=1, allow_nan=False) + "\n")
-        out(f"\nResults as JSON: `{path}`.")
+    if json_path is not None:
+        write_json(json_path, res, complete=True)
+        out(f"\nResults as JSON: `{json_path}`.")
     total = time.perf_counter() - start
     out(f"\nWhole run: {total / 60:.1f} min; load average at the end {os.getloadavg()[0]:.2f}.")
     return 0

@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from ._benches import BENCHES, load_bench
 from ._data import require_real
@@ -51,6 +52,8 @@ def test_the_thread_section_as_json(tmp_path: Path) -> None:
     data = json.loads(path.read_text())
     assert "commit" in data["machine"]
     assert data["argv"][-2:] == ["--json", str(path)]
+    assert data["complete"] is True
+    assert not path.with_name(path.name + ".part").exists()
     assert list(data["sections"]) == ["threads"]
     t = data["sections"]["threads"]
     # --quick: three one- and two-thread runs, each with its ratio, start and CPUs.
@@ -73,3 +76,25 @@ def test_the_thread_section_as_json(tmp_path: Path) -> None:
     assert row.group(1) == f"{t['ratio']:.2f}"
     assert f"late in {t['late_runs']} of {runs} runs)" in proc.stdout
     assert f"Results as JSON: `{path}`." in proc.stdout
+
+
+def test_a_run_stopped_part_way_keeps_the_sections_it_ran(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The JSON is written after each section, marked incomplete until the end."""
+    path = tmp_path / "speed.json"
+
+    def fails(args: object) -> dict[str, object]:
+        raise RuntimeError("insert section failed")
+
+    monkeypatch.setattr(speed, "section_match", lambda args: {"median_ms": np.float64(0.1)})
+    monkeypatch.setattr(speed, "section_insert", fails)
+    monkeypatch.setattr(
+        sys, "argv", ["speed.py", "--quick", "--sections", "match", "insert", "--json", str(path)]
+    )
+    with pytest.raises(RuntimeError, match=r"^insert section failed$"):
+        speed.main()
+    data = json.loads(path.read_text())
+    assert data["complete"] is False
+    assert data["sections"] == {"match": {"median_ms": 0.1}}
+    assert data["argv"][-1] == str(path)
