@@ -1145,12 +1145,16 @@ def section_odometry(args: argparse.Namespace) -> dict[str, Any]:
 
 def points_sweep(args: argparse.Namespace) -> list[dict[str, float]]:
     """Match time against scan points: one map (20 simulated 683-beam scans), the test
-    scans simulated with ``beams`` beams at the poses after the map's, local starts."""
+    scans simulated with ``beams`` beams at the poses after the map's, local starts.
+
+    Every scan and start is drawn first, in the order of the beam counts; the matches
+    are then timed with the beam counts in turn (for each map and start, each count once),
+    so that a spell of the machine slows every count alike instead of the one timed
+    during it (BENCHMARK.md, "Speed", session 47)."""
     pts, poses = sim_urg_scans(10_000, args.seed)
     room = sim.sticks_room()
     rng = np.random.default_rng(args.seed + 1)
     centres = np.linspace(WINDOW, len(pts) - 1, args.sweep_maps).astype(int)
-    rows = []
     maps = []
     for k in centres:
         grid = ndtgrid.NdtGrid(CELL)
@@ -1158,29 +1162,39 @@ def points_sweep(args: argparse.Namespace) -> list[dict[str, float]]:
             grid.insert(pts[j], poses[j])
         grid.match(pts[k - 1], poses[k - 1])  # build the distributions
         maps.append(grid)
-    for beams in progress(args.sweep_points, "sweep: scan points"):
+    # cases[b][m]: the scan of beam count b at map m, and its starts.
+    cases: list[list[tuple[F64, F64]]] = []
+    for beams in args.sweep_points:
         laser = dataclasses.replace(sim.URG04LX, num_beams=int(beams))
-        times, npts, iters = [], [], []
-        for k, grid in zip(centres, maps):
+        row = []
+        for k in centres:
             r, a = laser.scan(room, poses[k], rng=rng)
             src = ndtgrid.ranges_to_points(r, a, max_range=laser.max_range)
-            grid.match(src, poses[k])  # warm-up
-            with no_gc():
-                for d in convergence.starts(rng, args.starts, 0.05, 2.0):
+            row.append((src, poses[k] + convergence.starts(rng, args.starts, 0.05, 2.0)))
+        cases.append(row)
+    times: list[list[float]] = [[] for _ in cases]
+    iters: list[list[int]] = [[] for _ in cases]
+    for m in progress(range(len(maps)), "sweep: scan points"):
+        grid = maps[m]
+        for row in cases:
+            grid.match(row[m][0], poses[centres[m]])  # warm-up
+        with no_gc():
+            for s in range(args.starts):
+                for b, row in enumerate(cases):
+                    src, guesses = row[m]
                     t0 = time.perf_counter()
-                    m = grid.match(src, poses[k] + d)
-                    times.append(time.perf_counter() - t0)
-                    iters.append(m.iterations)
-                    npts.append(len(src))
-        rows.append(
-            {
-                "beams": float(beams),
-                "points": float(np.mean(npts)),
-                "median": float(np.median(times)),
-                "iterations": float(np.median(iters)),
-            }
-        )
-    return rows
+                    res = grid.match(src, guesses[s])
+                    times[b].append(time.perf_counter() - t0)
+                    iters[b].append(res.iterations)
+    return [
+        {
+            "beams": float(beams),
+            "points": float(np.mean([len(src) for src, _ in row])),
+            "median": float(np.median(t)),
+            "iterations": float(np.median(it)),
+        }
+        for beams, row, t, it in zip(args.sweep_points, cases, times, iters)
+    ]
 
 
 def intel_corrected() -> tuple[list[F64], F64]:
@@ -1287,7 +1301,8 @@ def section_sweeps(args: argparse.Namespace) -> dict[str, Any]:
             f"Maps: {WINDOW} simulated 683-beam URG-04LX scans of the sticks room (2 cm), "
             f"{args.sweep_maps} places; the "
             "matched scan is simulated with more or fewer beams over the same 240° at the "
-            f"next pose; {args.starts} local starts each; default `match()`.\n",
+            f"next pose; {args.starts} local starts each, timed with the beam counts in turn "
+            "(for each map and start, every count once); default `match()`.\n",
             "| beams | valid points | median [ms] | µs / point | median iterations |",
             "|---:|---:|---:|---:|---:|",
         ]
