@@ -195,13 +195,15 @@ def json_ready(value: Any) -> Any:
     return value
 
 
-def write_json(path: Path, sections: dict[str, dict[str, Any]], complete: bool) -> None:
-    """The sections run so far as ``--json``'s document at ``path``: the machine, the
-    command line, ``complete`` (false until every section asked for has run and the
-    targets are judged) and the sections. Written to a file beside ``path`` and renamed
-    over it, so a reader never sees half a document."""
+def write_json(
+    path: Path, machine: str, sections: dict[str, dict[str, Any]], complete: bool
+) -> None:
+    """The sections run so far as ``--json``'s document at ``path``: ``machine`` (the
+    run's header names it), the command line, ``complete`` (false until every section
+    asked for has run and the targets are judged) and the sections. Written to a file
+    beside ``path`` and renamed over it, so a reader never sees half a document."""
     doc = {
-        "machine": datasets.machine() + dirty(),
+        "machine": machine,
         "argv": sys.argv[1:],
         "complete": complete,
         "sections": sections,
@@ -2080,9 +2082,10 @@ def main() -> int:
         return 0
 
     start = time.perf_counter()
+    machine, changes = datasets.machine(), dirty()
     out("# ndtgrid speed (`benches/speed.py`)\n")
     out(
-        f"Machine: {datasets.machine()}{dirty()}; ndtgrid {ndtgrid.__version__}; numpy "
+        f"Machine: {machine}{changes}; ndtgrid {ndtgrid.__version__}; numpy "
         f"{np.__version__}; load average at start {os.getloadavg()[0]:.2f}; command "
         f"`{' '.join(['python benches/speed.py', *sys.argv[1:]])}`."
     )
@@ -2109,13 +2112,13 @@ def main() -> int:
             log(f"section {name}: {time.perf_counter() - t0:.0f} s")
             if json_path is not None:
                 # After each section, so a run stopped part-way keeps what it measured.
-                write_json(json_path, res, complete=False)
+                write_json(json_path, machine + changes, res, complete=False)
     if args.plot_peers and res.keys() & {"match", "insert", "odometry"}:
         out("\n## Ours against the peers, in one picture")
-        plotted(speed_plots.plot_peers(res, Path(args.plot_peers), datasets.machine()))
+        plotted(speed_plots.plot_peers(res, Path(args.plot_peers), machine))
     targets(res)
     if json_path is not None:
-        write_json(json_path, res, complete=True)
+        write_json(json_path, machine + changes, res, complete=True)
         out(f"\nResults as JSON: `{json_path}`.")
     total = time.perf_counter() - start
     out(f"\nWhole run: {total / 60:.1f} min; load average at the end {os.getloadavg()[0]:.2f}.")
