@@ -201,7 +201,9 @@ def write_json(
     """The sections run so far as ``--json``'s document at ``path``: ``machine`` (the
     run's header names it), the command line, ``complete`` (false until every section
     asked for has run and the targets are judged) and the sections. Written to a file
-    beside ``path`` and renamed over it, so a reader never sees half a document."""
+    beside ``path`` and renamed over it, so a reader never sees half a document; if
+    the write or the rename fails (a full disk, Ctrl-C), that file is removed and
+    ``path`` keeps the last whole document."""
     doc = {
         "machine": machine,
         "argv": sys.argv[1:],
@@ -211,8 +213,12 @@ def write_json(
     text = json.dumps(json_ready(doc), indent=1, allow_nan=False) + "\n"
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".part")
-    tmp.write_text(text)
-    tmp.replace(path)
+    try:
+        tmp.write_text(text)
+        tmp.replace(path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 def rss_kib() -> tuple[int, int]:

@@ -98,3 +98,26 @@ def test_a_run_stopped_part_way_keeps_the_sections_it_ran(
     assert data["complete"] is False
     assert data["sections"] == {"match": {"median_ms": 0.1}}
     assert data["argv"][-1] == str(path)
+
+
+def test_a_failed_write_leaves_the_last_document_and_no_part_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A write that fails half-way removes its ``.part`` file; the JSON at the path is
+    still the last whole document."""
+    path = tmp_path / "speed.json"
+    part = path.with_name(path.name + ".part")
+    speed.write_json(path, "machine A", {"match": {"ours": 0.1}}, complete=False)
+    first = path.read_text()
+
+    def full_disk(self: Path, target: Path) -> Path:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(Path, "replace", full_disk)
+    with pytest.raises(OSError, match=r"No space left on device$"):
+        speed.write_json(
+            path, "machine A", {"match": {"ours": 0.1}, "insert": {"ours": 4e-5}}, complete=True
+        )
+    assert not part.exists()
+    assert path.read_text() == first
+    assert json.loads(first)["sections"] == {"match": {"ours": 0.1}}
