@@ -217,7 +217,8 @@ def write_json(
         tmp.write_text(text)
         tmp.replace(path)
     except BaseException:
-        tmp.unlink(missing_ok=True)
+        with contextlib.suppress(OSError):  # the first error is the one to report
+            tmp.unlink(missing_ok=True)
         raise
 
 

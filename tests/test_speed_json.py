@@ -121,3 +121,22 @@ def test_a_failed_write_leaves_the_last_document_and_no_part_file(
     assert not part.exists()
     assert path.read_text() == first
     assert json.loads(first)["sections"] == {"match": {"ours": 0.1}}
+
+
+def test_a_failed_write_reports_its_own_error_when_the_cleanup_fails_too(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """If the part file cannot be removed either, the write's error is the one raised."""
+    path = tmp_path / "speed.json"
+
+    def full_disk(self: Path, target: Path) -> Path:
+        raise OSError(28, "No space left on device")
+
+    def denied(self: Path, missing_ok: bool = False) -> None:
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(Path, "replace", full_disk)
+    monkeypatch.setattr(Path, "unlink", denied)
+    with pytest.raises(OSError, match=r"No space left on device$") as info:
+        speed.write_json(path, "machine A", {}, complete=False)
+    assert not isinstance(info.value, PermissionError)
