@@ -12,35 +12,11 @@
 use std::error::Error;
 use std::time::Instant;
 
-use ndt_core::{MatchOptions, NdtGrid, Pose2};
+use ndt_core::{MatchOptions, NdtGrid};
 
-/// Scans in the map before the timed inserts (as `speed.py`).
-const PREFILL: usize = 100;
-
-/// One scan: scan-frame points and the pose they were seen from.
-type Scan = (Vec<[f64; 2]>, Pose2);
-
-/// The scans of `bytes` (see `benches/dump_insert_case.py`).
-fn scans(bytes: &[u8]) -> Result<Vec<Scan>, Box<dyn Error>> {
-    let mut words = bytes
-        .chunks_exact(8)
-        .map(|w| <[u8; 8]>::try_from(w).unwrap_or([0; 8]));
-    let mut out = Vec::new();
-    while let Some(count) = words.next() {
-        let n = usize::try_from(i64::from_le_bytes(count))?;
-        let mut values = words.by_ref().take(2 * n + 3).map(f64::from_le_bytes);
-        let points: Vec<[f64; 2]> = (0..n)
-            .map_while(|_| Some([values.next()?, values.next()?]))
-            .collect();
-        match (values.next(), values.next(), values.next()) {
-            (Some(x), Some(y), Some(theta)) if points.len() == n => {
-                out.push((points, Pose2::new(x, y, theta)));
-            }
-            _ => return Err("the file ends inside a scan".into()),
-        }
-    }
-    Ok(out)
-}
+#[path = "common/insert_scans.rs"]
+mod insert_scans;
+use insert_scans::{scans, PREFILL};
 
 fn main() -> Result<(), Box<dyn Error>> {
     let mut args = std::env::args().skip(1);

@@ -17,14 +17,9 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-/// One xorshift64 step.
-#[inline(always)]
-fn step(mut x: u64) -> u64 {
-    x ^= x << 13;
-    x ^= x >> 7;
-    x ^= x << 17;
-    x
-}
+#[path = "common/controls.rs"]
+mod controls;
+use controls::{chase_cycle, step};
 
 /// Milliseconds of 20 M dependent steps.
 fn chain() -> f64 {
@@ -51,21 +46,8 @@ fn chains8() -> f64 {
 /// Nanoseconds per load of a chase through `bytes` of memory: one node per
 /// 64-byte line, the nodes in one random cycle (Sattolo's shuffle).
 fn chase(bytes: usize) -> f64 {
-    const WORDS_PER_LINE: usize = 8;
-    let n = (bytes / 64).max(2);
-    let mut order: Vec<usize> = (0..n).collect();
-    let mut r = 12_345_u64;
-    for i in (1..n).rev() {
-        r = step(r);
-        order.swap(i, (r % i as u64) as usize);
-    }
-    let mut next = vec![0_usize; n * WORDS_PER_LINE];
-    for (i, &from) in order.iter().enumerate() {
-        let to = order.get((i + 1) % n).copied().unwrap_or(0);
-        if let Some(slot) = next.get_mut(from * WORDS_PER_LINE) {
-            *slot = to * WORDS_PER_LINE;
-        }
-    }
+    let next = chase_cycle(bytes);
+    let n = next.len() / controls::WORDS_PER_LINE;
     let load = |at: usize| next.get(at).copied().unwrap_or(0);
     // Once round the cycle to warm it, then timed.
     let mut at = 0;
