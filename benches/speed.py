@@ -2089,10 +2089,11 @@ def main() -> int:
         return 0
 
     start = time.perf_counter()
-    machine, changes = datasets.machine(), dirty()
+    machine = datasets.machine()
+    stamp = machine + dirty()  # the machine and the work tree's commit and state
     out("# ndtgrid speed (`benches/speed.py`)\n")
     out(
-        f"Machine: {machine}{changes}; ndtgrid {ndtgrid.__version__}; numpy "
+        f"Machine: {stamp}; ndtgrid {ndtgrid.__version__}; numpy "
         f"{np.__version__}; load average at start {os.getloadavg()[0]:.2f}; command "
         f"`{' '.join(['python benches/speed.py', *sys.argv[1:]])}`."
     )
@@ -2119,13 +2120,13 @@ def main() -> int:
             log(f"section {name}: {time.perf_counter() - t0:.0f} s")
             if json_path is not None:
                 # After each section, so a run stopped part-way keeps what it measured.
-                write_json(json_path, machine + changes, res, complete=False)
+                write_json(json_path, stamp, res, complete=False)
     if args.plot_peers and res.keys() & {"match", "insert", "odometry"}:
         out("\n## Ours against the peers, in one picture")
         plotted(speed_plots.plot_peers(res, Path(args.plot_peers), machine))
     targets(res)
     if json_path is not None:
-        write_json(json_path, machine + changes, res, complete=True)
+        write_json(json_path, stamp, res, complete=True)
         out(f"\nResults as JSON: `{json_path}`.")
     total = time.perf_counter() - start
     out(f"\nWhole run: {total / 60:.1f} min; load average at the end {os.getloadavg()[0]:.2f}.")
