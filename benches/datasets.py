@@ -43,6 +43,8 @@ from ndtgrid.evaluation import RelationSummary, relation_errors
 from ndtgrid.io import Scan, read_benchmark_index, read_benchmark_split
 
 F64 = npt.NDArray[np.float64]
+# The repository (git is asked about its commit here, wherever the script runs from).
+REPO = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "benchmark-scans-split"
 #: name -> (index CSV stem, label, published sequential scan matching [m], Kümmerle 2009).
 DATASETS = {
@@ -245,11 +247,30 @@ def machine() -> str:
     cpu = f"{processor_name()}, {kernels_name()}"
     try:
         commit = subprocess.run(
-            ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True
+            ["git", "rev-parse", "--short", "HEAD"],
+            capture_output=True,
+            text=True,
+            check=True,
+            cwd=REPO,
         ).stdout.strip()
     except (OSError, subprocess.CalledProcessError):
         commit = "unknown"
     return f"{os.cpu_count()} cores of {cpu}, Python {platform.python_version()}, commit {commit}"
+
+
+def dirty() -> str:
+    """`` (+ uncommitted changes)`` when the work tree differs from HEAD, else ``""``."""
+    try:
+        st = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no"],
+            capture_output=True,
+            text=True,
+            check=True,
+            cwd=REPO,
+        ).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return ""
+    return " (+ uncommitted changes)" if st.strip() else ""
 
 
 def main() -> int:

@@ -1997,21 +1997,6 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
         row("bytes per occupied cell (with distributions)", f"{mem['bytes_per_cell']:.0f}", None)
 
 
-def dirty() -> str:
-    """`` (+ uncommitted changes)`` when the work tree differs from HEAD, else ``""``."""
-    try:
-        st = subprocess.run(
-            ["git", "status", "--porcelain", "--untracked-files=no"],
-            capture_output=True,
-            text=True,
-            check=True,
-            cwd=ROOT,
-        ).stdout
-    except (OSError, subprocess.CalledProcessError):
-        return ""
-    return " (+ uncommitted changes)" if st.strip() else ""
-
-
 def main() -> int:
     """Parse the options and run the sections."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -2090,7 +2075,7 @@ def main() -> int:
 
     start = time.perf_counter()
     machine = datasets.machine()
-    stamp = machine + dirty()  # the machine and the work tree's commit and state
+    stamp = machine + datasets.dirty()  # the machine and the work tree's commit and state
     out("# ndtgrid speed (`benches/speed.py`)\n")
     out(
         f"Machine: {stamp}; ndtgrid {ndtgrid.__version__}; numpy "

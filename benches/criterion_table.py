@@ -1,0 +1,176 @@
+"""Criterion's results as BENCHMARK.md's table: ``python benches/criterion_table.py``.
+
+``cargo bench`` leaves each benchmark's estimates in ``target/criterion/<id>/new/
+estimates.json``. This prints them in Markdown the way BENCHMARK.md records them: the
+machine and commit, the insert, pyramid and match groups by cell size and scan points,
+the other groups one line each, and the targets of issue 7 that criterion times (a
+683-point scan inserted in ≤ 50 µs, matched on a 2 cm map in ≤ 0.2 ms). Each time is
+the one criterion's ``time:`` line shows: the slope of its linear fit where it made one,
+else the mean.
+
+Run from the repository root after ``cargo bench``::
+
+    python benches/criterion_table.py
+    python benches/criterion_table.py --dir other/target/criterion
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections.abc import Iterable
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import datasets
+
+ROOT = Path(__file__).resolve().parents[1]
+# The groups of crates/ndt-core/benches/core.rs timed by cell size and scan points.
+GRID_GROUPS = (
+    "insert",
+    "insert_sums_only",
+    "insert_loop",
+    "pyramid_update",
+    "match",
+    "match_paper",
+)
+# Criterion's function names of the cell sizes, and their labels.
+CELLS = {"cell_2cm": "2 cm", "cell_20cm": "20 cm"}
+BEAMS = (180, 361, 683, 2000)
+BATCHES = (1, 4, 16, 64)
+LARGE = (8192, 16384, 32000)
+ODOMETRY = ("181_beams_2cm", "181_beams_2cm_mapper_behind", "181_beams_2cm_poses_only")
+# Issue 7's targets that criterion times: (benchmark, limit [s], what).
+TARGETS = (
+    ("insert/cell_2cm/683", 50e-6, "insert of a 683-point scan ≤ 50 µs (into a fresh clone)"),
+    ("insert_loop/cell_2cm/683", 50e-6, "insert of a 683-point scan ≤ 50 µs (a loop's inserts)"),
+    ("match/cell_2cm/683", 2e-4, "match of a 683-point scan on a 2 cm map ≤ 0.2 ms"),
+)
+
+
+def estimate(root: Path, bench: str) -> float | None:
+    """The time [s] criterion shows for ``bench`` (``group/function/value``) under
+    ``root``: its slope, else its mean; ``None`` when it has not been run.
+
+    Raises
+    ------
+    ValueError
+        The estimates file is there but holds neither estimate.
+    """
+    path = root / bench / "new" / "estimates.json"
+    if not path.is_file():
+        return None
+    doc = json.loads(path.read_text(encoding="utf-8"))
+    for kind in ("slope", "mean"):
+        entry = doc.get(kind)
+        if isinstance(entry, dict) and isinstance(entry.get("point_estimate"), (int, float)):
+            return float(entry["point_estimate"]) * 1e-9
+    raise ValueError(f"{path}: no slope or mean point estimate")
+
+
+def fmt(seconds: float | None) -> str:
+    """A time as BENCHMARK.md writes it: µs with one decimal below 1 ms, else ms with
+    three; a dash when not measured."""
+    if seconds is None:
+        return "–"
+    return f"{seconds * 1e6:.1f} µs" if seconds < 1e-3 else f"{seconds * 1e3:.3f} ms"
+
+
+def _series(times: Iterable[float | None]) -> str:
+    """Times joined by `` / `` with the unit once, at the end."""
+    parts = [fmt(t) for t in times]
+    units = {p.split()[1] for p in parts if p != "–"}
+    if len(units) == 1:
+        unit = units.pop()
+        return " / ".join(p.split()[0] for p in parts) + f" {unit}"
+    return " / ".join(parts)
+
+
+def table(root: Path) -> list[str]:
+    """The Markdown lines for the results under ``root`` (see the module docs).
+
+    Raises
+    ------
+    FileNotFoundError
+        ``root`` holds no criterion results.
+    """
+    if not root.is_dir() or next(root.rglob("estimates.json"), None) is None:
+        raise FileNotFoundError(f"no criterion results in {root}: run `cargo bench` first")
+    est: dict[str, float | None] = {}
+
+    def t(bench: str) -> float | None:
+        if bench not in est:
+            est[bench] = estimate(root, bench)
+        return est[bench]
+
+    head = " | ".join(f"{label}: {' / '.join(map(str, BEAMS))} points" for label in CELLS.values())
+    lines = [f"| group | {head} |", "|---|" + "---|" * len(CELLS)]
+    for g in GRID_GROUPS:
+        times = [[t(f"{g}/{c}/{b}") for b in BEAMS] for c in CELLS]
+        if all(v is None for col in times for v in col):
+            continue
+        # A size the group does not time is left blank (`insert_loop`: 2 cm only).
+        cols = ["" if all(v is None for v in col) else _series(col) for col in times]
+        lines.append(f"| {g} | " + " | ".join(cols) + " |")
+    lines.append("")
+    many = [t(f"insert_many/cell_2cm_683/{n}") for n in BATCHES]
+    if any(m is not None for m in many):
+        per_scan = [None if m is None else m / n for m, n in zip(many, BATCHES)]
+        lines.append(
+            f"- `insert_many` (2 cm, 683 points), batches of {' / '.join(map(str, BATCHES))} "
+            f"scans: {_series(per_scan)} a scan ({_series(many)} a call)."
+        )
+    for n in LARGE:
+        one, par = t(f"match_large/one_thread/{n}"), t(f"match_large/parallel/{n}")
+        if one is not None or par is not None:
+            gain = f" ({one / par:.2f}×)" if one and par else ""
+            lines.append(
+                f"- `match_large` (2 cm), {n} points, one thread / `parallel`: "
+                f"{_series([one, par])}{gain}."
+            )
+    one, every = t("match_many/one_thread"), t("match_many/every_core")
+    if one is not None or every is not None:
+        gain = f" ({one / every:.2f}×)" if one and every else ""
+        lines.append(
+            f"- `match_many`, 64 scans: {fmt(one)} on one thread, {fmt(every)} on every core{gain}."
+        )
+    odo = [t(f"odometry_step/{o}") for o in ODOMETRY]
+    if any(o is not None for o in odo):
+        lines.append(
+            "- `odometry_step`: "
+            + "; ".join(f"`{name}` {fmt(v)}" for name, v in zip(ODOMETRY, odo))
+            + "."
+        )
+    lines += ["", "| target (issue 7) | criterion | met |", "|---|---|---|"]
+    for bench, limit, what in TARGETS:
+        v = t(bench)
+        met = "–" if v is None else "yes" if v <= limit else "no"
+        lines.append(f"| {what} | `{bench}` {fmt(v)} | {met} |")
+    return lines
+
+
+def main() -> int:
+    """Print the table for ``--dir`` (``target/criterion`` by default)."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--dir", type=Path, default=ROOT / "target" / "criterion")
+    args = ap.parse_args()
+    try:
+        lines = table(args.dir)
+    except (FileNotFoundError, ValueError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    newest = max(p.stat().st_mtime for p in args.dir.rglob("new/estimates.json"))
+    written = time.strftime("%Y-%m-%d %H:%M", time.localtime(newest))
+    print(
+        f"Machine (and the commit checked out now): {datasets.machine()}{datasets.dirty()}; "
+        f"results in {args.dir}, the newest written {written}\n"
+    )
+    print("\n".join(lines))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

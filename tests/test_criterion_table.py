@@ -1,0 +1,104 @@
+"""`benches/criterion_table.py`: criterion's estimates read and judged as BENCHMARK.md
+records them, on a criterion tree written here."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests._benches import load_bench
+
+ct = load_bench("criterion_table")
+# What the table writes for a time not measured, and its ratio sign.
+NA = ct.fmt(None)
+TIMES = "\N{MULTIPLICATION SIGN}"
+
+
+def write(root: Path, bench: str, slope: float | None, mean: float | None = None) -> None:
+    """Criterion's ``new/estimates.json`` for ``bench`` with these point estimates [ns]."""
+    d = root / bench / "new"
+    d.mkdir(parents=True)
+    doc = {
+        "mean": None if mean is None else {"point_estimate": mean},
+        "median": {"point_estimate": 1.0},
+        "slope": None if slope is None else {"point_estimate": slope},
+    }
+    (d / "estimates.json").write_text(json.dumps(doc))
+
+
+def test_slope_else_mean_and_the_targets(tmp_path: Path) -> None:
+    write(tmp_path, "insert/cell_2cm/683", slope=51_000.0, mean=1.0)
+    write(tmp_path, "insert_loop/cell_2cm/683", slope=None, mean=49_000.0)
+    write(tmp_path, "match/cell_2cm/683", slope=98_600.0)
+    write(tmp_path, "match_many/one_thread", slope=6.5e6)
+    write(tmp_path, "match_many/every_core", slope=3.25e6)
+    lines = ct.table(tmp_path)
+    assert f"| insert | {NA} / {NA} / 51.0 / {NA} µs |  |" in lines
+    assert f"| insert_loop | {NA} / {NA} / 49.0 / {NA} µs |  |" in lines
+    # Groups not run at all have no row.
+    assert not any(line.startswith("| pyramid_update") for line in lines)
+    assert (
+        f"- `match_many`, 64 scans: 6.500 ms on one thread, 3.250 ms on every core (2.00{TIMES})."
+        in lines
+    )
+    assert (
+        "| insert of a 683-point scan ≤ 50 µs (into a fresh clone) "
+        "| `insert/cell_2cm/683` 51.0 µs | no |" in lines
+    )
+    assert (
+        "| insert of a 683-point scan ≤ 50 µs (a loop's inserts) "
+        "| `insert_loop/cell_2cm/683` 49.0 µs | yes |" in lines
+    )
+    assert (
+        "| match of a 683-point scan on a 2 cm map ≤ 0.2 ms "
+        "| `match/cell_2cm/683` 98.6 µs | yes |" in lines
+    )
+
+
+def test_a_target_not_run_is_not_judged(tmp_path: Path) -> None:
+    write(tmp_path, "match/cell_20cm/180", slope=16_600.0)
+    lines = ct.table(tmp_path)
+    assert f"| match |  | 16.6 / {NA} / {NA} / {NA} µs |" in lines
+    assert (
+        "| insert of a 683-point scan ≤ 50 µs (into a fresh clone) "
+        f"| `insert/cell_2cm/683` {NA} | {NA} |" in lines
+    )
+
+
+def test_batches_per_scan_and_times_in_ms(tmp_path: Path) -> None:
+    for n, call in ((1, 47_600.0), (4, 116_640.0), (16, 293_980.0), (64, 816_980.0)):
+        write(tmp_path, f"insert_many/cell_2cm_683/{n}", slope=call)
+    write(tmp_path, "match_large/one_thread/16384", slope=2.285e6)
+    write(tmp_path, "match_large/parallel/16384", slope=1.839e6)
+    lines = ct.table(tmp_path)
+    assert (
+        "- `insert_many` (2 cm, 683 points), batches of 1 / 4 / 16 / 64 scans: "
+        "47.6 / 29.2 / 18.4 / 12.8 µs a scan (47.6 / 116.6 / 294.0 / 817.0 µs a call)."
+    ) in lines
+    assert (
+        "- `match_large` (2 cm), 16384 points, one thread / `parallel`: "
+        f"2.285 / 1.839 ms (1.24{TIMES})."
+    ) in lines
+
+
+def test_estimates_without_a_point_estimate_are_an_error(tmp_path: Path) -> None:
+    write(tmp_path, "insert/cell_2cm/683", slope=None, mean=None)
+    path = tmp_path / "insert" / "cell_2cm" / "683" / "new" / "estimates.json"
+    with pytest.raises(ValueError) as e:
+        ct.table(tmp_path)
+    assert str(e.value) == f"{path}: no slope or mean point estimate"
+
+
+def test_no_results_is_a_clear_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(FileNotFoundError) as e:
+        ct.table(tmp_path)
+    assert str(e.value) == f"no criterion results in {tmp_path}: run `cargo bench` first"
+    monkeypatch.setattr(sys, "argv", ["criterion_table.py", "--dir", str(tmp_path / "absent")])
+    assert ct.main() == 2
+    err = capsys.readouterr().err
+    assert err == f"error: no criterion results in {tmp_path / 'absent'}: run `cargo bench` first\n"
