@@ -241,35 +241,28 @@ def fmt_rot(s: RelationSummary) -> str:
     return f"{s.rotation_mean:.2f} ± {s.rotation_std:.2f} ({s.rotation_max:.1f})"
 
 
+def git(*args: str) -> str | None:
+    """The output of ``git args`` run in the repository, ``None`` when git cannot
+    answer (not installed, not a clone)."""
+    try:
+        return subprocess.run(
+            ["git", *args], capture_output=True, text=True, check=True, cwd=REPO
+        ).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return None
+
+
 def machine() -> str:
     """Cores, processor and kernels (:func:`ndtgrid.bench.processor_name`,
     :func:`ndtgrid.bench.kernels_name`), Python and commit."""
     cpu = f"{processor_name()}, {kernels_name()}"
-    try:
-        commit = subprocess.run(
-            ["git", "rev-parse", "--short", "HEAD"],
-            capture_output=True,
-            text=True,
-            check=True,
-            cwd=REPO,
-        ).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        commit = "unknown"
+    commit = (git("rev-parse", "--short", "HEAD") or "unknown").strip()
     return f"{os.cpu_count()} cores of {cpu}, Python {platform.python_version()}, commit {commit}"
 
 
 def dirty() -> str:
     """`` (+ uncommitted changes)`` when the work tree differs from HEAD, else ``""``."""
-    try:
-        st = subprocess.run(
-            ["git", "status", "--porcelain", "--untracked-files=no"],
-            capture_output=True,
-            text=True,
-            check=True,
-            cwd=REPO,
-        ).stdout
-    except (OSError, subprocess.CalledProcessError):
-        return ""
+    st = git("status", "--porcelain", "--untracked-files=no") or ""
     return " (+ uncommitted changes)" if st.strip() else ""
 
 
