@@ -63,12 +63,21 @@ def estimate(root: Path, bench: str) -> float | None:
     path = root / bench / "new" / "estimates.json"
     if not path.is_file():
         return None
-    doc = json.loads(path.read_text(encoding="utf-8"))
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{path}: not JSON ({e})") from e
     for kind in ("slope", "mean"):
         entry = doc.get(kind)
         if isinstance(entry, dict) and isinstance(entry.get("point_estimate"), (int, float)):
             return float(entry["point_estimate"]) * 1e-9
     raise ValueError(f"{path}: no slope or mean point estimate")
+
+
+def results(root: Path) -> list[Path]:
+    """The estimates files of the last run of each benchmark under ``root`` (criterion
+    keeps the run before in ``base/``), none when ``root`` is not a directory."""
+    return sorted(root.rglob("new/estimates.json")) if root.is_dir() else []
 
 
 def fmt(seconds: float | None) -> str:
@@ -96,8 +105,10 @@ def table(root: Path) -> list[str]:
     ------
     FileNotFoundError
         ``root`` holds no criterion results.
+    ValueError
+        An estimates file is not JSON or holds neither estimate.
     """
-    if not root.is_dir() or next(root.rglob("estimates.json"), None) is None:
+    if not results(root):
         raise FileNotFoundError(f"no criterion results in {root}: run `cargo bench` first")
     est: dict[str, float | None] = {}
 
@@ -162,7 +173,7 @@ def main() -> int:
     except (FileNotFoundError, ValueError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    newest = max(p.stat().st_mtime for p in args.dir.rglob("new/estimates.json"))
+    newest = max(p.stat().st_mtime for p in results(args.dir))
     written = time.strftime("%Y-%m-%d %H:%M", time.localtime(newest))
     print(
         f"Machine (and the commit checked out now): {datasets.machine()}{datasets.dirty()}; "

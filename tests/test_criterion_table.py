@@ -102,3 +102,21 @@ def test_no_results_is_a_clear_error(
     assert ct.main() == 2
     err = capsys.readouterr().err
     assert err == f"error: no criterion results in {tmp_path / 'absent'}: run `cargo bench` first\n"
+
+
+def test_a_broken_estimates_file_is_named(tmp_path: Path) -> None:
+    path = tmp_path / "match" / "cell_2cm" / "683" / "new" / "estimates.json"
+    path.parent.mkdir(parents=True)
+    path.write_text("{")
+    with pytest.raises(ValueError, match="not JSON") as e:
+        ct.table(tmp_path)
+    assert str(e.value).startswith(f"{path}: not JSON (")
+
+
+def test_only_an_earlier_run_is_no_results(tmp_path: Path) -> None:
+    # criterion's `base/` holds the run before the last; without a `new/`, nothing ran.
+    d = tmp_path / "insert" / "cell_2cm" / "683" / "base"
+    d.mkdir(parents=True)
+    (d / "estimates.json").write_text('{"slope": {"point_estimate": 1.0}}')
+    with pytest.raises(FileNotFoundError):
+        ct.table(tmp_path)
