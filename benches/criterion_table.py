@@ -27,7 +27,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import datasets
 
-ROOT = Path(__file__).resolve().parents[1]
 # The groups of crates/ndt-core/benches/core.rs timed by cell size and scan points.
 GRID_GROUPS = (
     "insert",
@@ -80,22 +79,34 @@ def results(root: Path) -> list[Path]:
     return sorted(root.rglob("new/estimates.json")) if root.is_dir() else []
 
 
-def fmt(seconds: float | None) -> str:
-    """A time as BENCHMARK.md writes it: µs with one decimal below 1 ms, else ms with
-    three; a dash when not measured."""
+def _unit(seconds: float) -> str:
+    """BENCHMARK.md's unit for a time: µs below 1 ms, else ms."""
+    return "µs" if seconds < 1e-3 else "ms"
+
+
+def _number(seconds: float | None, unit: str) -> str:
+    """A time in ``unit``: µs with one decimal, ms with three; a dash when not measured."""
     if seconds is None:
         return "–"
-    return f"{seconds * 1e6:.1f} µs" if seconds < 1e-3 else f"{seconds * 1e3:.3f} ms"
+    return f"{seconds * 1e6:.1f}" if unit == "µs" else f"{seconds * 1e3:.3f}"
+
+
+def fmt(seconds: float | None) -> str:
+    """A time as BENCHMARK.md writes it, with its unit; a dash when not measured."""
+    if seconds is None:
+        return _number(None, "")
+    unit = _unit(seconds)
+    return f"{_number(seconds, unit)} {unit}"
 
 
 def _series(times: Iterable[float | None]) -> str:
-    """Times joined by `` / `` with the unit once, at the end."""
-    parts = [fmt(t) for t in times]
-    units = {p.split()[1] for p in parts if p != "–"}
+    """Times joined by `` / ``, with the unit once at the end when they share one."""
+    ts = list(times)
+    units = {_unit(t) for t in ts if t is not None}
     if len(units) == 1:
         unit = units.pop()
-        return " / ".join(p.split()[0] for p in parts) + f" {unit}"
-    return " / ".join(parts)
+        return " / ".join(_number(t, unit) for t in ts) + f" {unit}"
+    return " / ".join(fmt(t) for t in ts)
 
 
 def table(root: Path) -> list[str]:
@@ -108,8 +119,10 @@ def table(root: Path) -> list[str]:
     ValueError
         An estimates file is not JSON or holds neither estimate.
     """
-    if not results(root):
+    files = results(root)
+    if not files:
         raise FileNotFoundError(f"no criterion results in {root}: run `cargo bench` first")
+    newest = time.localtime(max(f.stat().st_mtime for f in files))
     est: dict[str, float | None] = {}
 
     def t(bench: str) -> float | None:
@@ -118,7 +131,12 @@ def table(root: Path) -> list[str]:
         return est[bench]
 
     head = " | ".join(f"{label}: {' / '.join(map(str, BEAMS))} points" for label in CELLS.values())
-    lines = [f"| group | {head} |", "|---|" + "---|" * len(CELLS)]
+    lines = [
+        f"Results in {root}, the newest written {time.strftime('%Y-%m-%d %H:%M', newest)}.",
+        "",
+        f"| group | {head} |",
+        "|---|" + "---|" * len(CELLS),
+    ]
     for g in GRID_GROUPS:
         times = [[t(f"{g}/{c}/{b}") for b in BEAMS] for c in CELLS]
         if all(v is None for col in times for v in col):
@@ -166,19 +184,14 @@ def table(root: Path) -> list[str]:
 def main() -> int:
     """Print the table for ``--dir`` (``target/criterion`` by default)."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--dir", type=Path, default=ROOT / "target" / "criterion")
+    ap.add_argument("--dir", type=Path, default=datasets.REPO / "target" / "criterion")
     args = ap.parse_args()
     try:
         lines = table(args.dir)
     except (FileNotFoundError, ValueError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    newest = max(p.stat().st_mtime for p in results(args.dir))
-    written = time.strftime("%Y-%m-%d %H:%M", time.localtime(newest))
-    print(
-        f"Machine (and the commit checked out now): {datasets.machine()}{datasets.dirty()}; "
-        f"results in {args.dir}, the newest written {written}\n"
-    )
+    print(f"Machine (and the commit checked out now): {datasets.machine()}{datasets.dirty()}\n")
     print("\n".join(lines))
     return 0
 
