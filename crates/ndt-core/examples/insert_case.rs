@@ -16,7 +16,7 @@ use ndt_core::{MatchOptions, NdtGrid};
 
 #[path = "common/insert_scans.rs"]
 mod insert_scans;
-use insert_scans::{scans, PREFILL};
+use insert_scans::{median, scans, PREFILL};
 
 fn main() -> Result<(), Box<dyn Error>> {
     let mut args = std::env::args().skip(1);
@@ -38,11 +38,10 @@ fn main() -> Result<(), Box<dyn Error>> {
         grid.insert(points, *pose)?;
         times.push(t.elapsed().as_secs_f64() * 1e6);
     }
-    times.sort_by(f64::total_cmp);
     println!(
         "{} inserts: median {:.1} us; the map holds {} cells",
         times.len(),
-        times.get(times.len() / 2).copied().unwrap_or(f64::NAN),
+        median(&mut times),
         grid.len()
     );
     Ok(())

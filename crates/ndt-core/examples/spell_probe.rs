@@ -31,7 +31,7 @@ mod controls;
 #[path = "common/insert_scans.rs"]
 mod insert_scans;
 use controls::{chase_cycle, step};
-use insert_scans::{scans, PREFILL};
+use insert_scans::{median, scans, PREFILL};
 
 /// What each round times: the insert and the five controls.
 const NAMES: [&str; 6] = ["insert", "chain", "chains8", "branch", "loads", "chase"];
@@ -62,11 +62,6 @@ fn branchy(pattern: &[u8], mut x: u64) -> u64 {
 
 fn micros(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e6
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// The five controls' times \[µs\].

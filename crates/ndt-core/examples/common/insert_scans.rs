@@ -1,6 +1,6 @@
 //! The scans `benches/dump_insert_case.py` writes (the simulated URG-04LX
 //! scans the 50 µs insert is judged on), for the examples that time
-//! the insert (`insert_case`, `spell_probe`).
+//! the insert (`insert_case`, `spell_probe`), and the median they report.
 
 use std::error::Error;
 
@@ -8,6 +8,13 @@ use ndt_core::Pose2;
 
 /// Scans in the map before the timed inserts (as `speed.py`).
 pub const PREFILL: usize = 100;
+
+/// The median of `v` (the upper one of an even count; NaN when empty),
+/// sorting `v`.
+pub fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
 
 /// One scan: scan-frame points and the pose they were seen from.
 pub type Scan = (Vec<[f64; 2]>, Pose2);
