@@ -13,6 +13,7 @@ use crate::occupancy::OccupancyProbe;
 use crate::pyramid::{Level, Pyramid, MAX_LEVELS};
 use crate::se2::Pose2;
 use crate::shape::{Shape, ShapeMemo};
+use crate::spare::clone_vec;
 use crate::table::CellTable;
 
 mod deferral;
@@ -84,7 +85,9 @@ pub struct NdtGrid {
 
 impl Clone for NdtGrid {
     /// A copy with its coarser levels up to date (a copy made inside a
-    /// deferral brings its own up to date at once).
+    /// deferral brings its own up to date at once), its storage with the
+    /// original's spare capacity ([`crate::spare`]): inserts into the copy
+    /// grow it as they would the original.
     fn clone(&self) -> Self {
         let mut copy = Self {
             cell_size: self.cell_size,
@@ -98,11 +101,11 @@ impl Clone for NdtGrid {
                     .map(|d| Arc::new(Distributions::clone(d)))
                     .collect(),
             ),
-            pending: self.pending.clone(),
+            pending: clone_vec(&self.pending),
             deferring: 1,
             // Another grid: its removals are its own from here on.
             removals: removals::Removals::new(),
-            shapes: ShapeMemo::default(),
+            shapes: self.shapes.clone(),
         };
         copy.end_deferral();
         copy
@@ -509,6 +512,58 @@ mod tests {
             sigma_floor: 0.02,
             shape_cell,
         }
+    }
+
+    /// Three walls of a room, seen from `pose` (map-frame points mapped
+    /// into the scan's frame), with a few lone points.
+    fn walls(pose: Pose2, shift: f64) -> Vec<[f64; 2]> {
+        let mut map: Vec<[f64; 2]> = (0..300)
+            .map(|i| [-1.5 + 0.01 * f64::from(i) + shift, 1.0])
+            .collect();
+        map.extend((0..250).map(|i| [1.6, -1.2 + 0.009 * f64::from(i) + shift]));
+        map.extend((0..200).map(|i| [-1.7 + shift, -1.0 + 0.0105 * f64::from(i)]));
+        map.extend([[0.3 + shift, -0.7], [-0.4, 0.2 + shift]]);
+        let (s, c) = pose.theta.sin_cos();
+        map.iter()
+            .map(|[x, y]| {
+                let (dx, dy) = (x - pose.x, y - pose.y);
+                [c * dx + s * dy, -s * dx + c * dy]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_clone_keeps_the_originals_storage_and_takes_an_insert_as_it_would() {
+        let mut grid = NdtGrid::new(0.02).unwrap();
+        for i in 0..6 {
+            let pose = Pose2::new(
+                0.05 * f64::from(i),
+                -0.03 * f64::from(i),
+                0.1 * f64::from(i),
+            );
+            grid.insert(&walls(pose, 0.004 * f64::from(i)), pose)
+                .unwrap();
+        }
+        // Prepared distributions of the default match, then one more insert,
+        // as a loop makes them: the grid's vectors have spare capacity.
+        let pose = Pose2::new(0.02, 0.01, 0.05);
+        let scan = walls(pose, 0.011);
+        grid.match_scan(&scan, pose, &crate::MatchOptions::default())
+            .unwrap();
+        grid.insert(&walls(pose, 0.007), pose).unwrap();
+        let mut copy = grid.clone();
+        // Every vector's capacity counted by `heap_bytes` is the original's
+        // (a derived clone's would be its length), and the reused storage of
+        // the shapes' memo too (a fresh memo's would be none).
+        assert_eq!(copy.heap_bytes(), grid.heap_bytes());
+        assert_eq!(copy.shapes.capacities(), grid.shapes.capacities());
+        assert!(grid.shapes.capacities().iter().any(|&c| c > 0));
+        // The same insert into both: the same sums and distributions.
+        let pose = Pose2::new(-0.03, 0.02, -0.04);
+        let scan = walls(pose, 0.013);
+        grid.insert(&scan, pose).unwrap();
+        copy.insert(&scan, pose).unwrap();
+        crate::testing::assert_same_grids(&grid, &copy);
     }
 
     #[test]

@@ -57,6 +57,7 @@ pub mod se2;
 pub mod shape;
 pub mod shaped;
 pub mod solver;
+mod spare;
 mod staging;
 pub mod table;
 #[cfg(test)]

@@ -10,6 +10,7 @@ use crate::gather;
 use crate::key::{CellKey, KeyBounds};
 use crate::occupancy::Occupancy;
 use crate::scratch::KeyScratch;
+use crate::spare::{clone_nested, clone_vec};
 use crate::table::CellTable;
 
 mod bookkeeping;
@@ -46,7 +47,7 @@ impl Level {
 }
 
 /// The fine grid and its coarser levels.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Pyramid {
     levels: Vec<Level>,
     /// A superset of the fine keys in use: grown by every insert, reset when
@@ -76,6 +77,25 @@ pub struct Pyramid {
     /// An insert's runs of points in one cell, with their sums (reused
     /// between updates).
     run_sums: Vec<(CellKey, CellStats)>,
+}
+
+/// A copy with the original's spare capacity, its reused storage included
+/// ([`crate::spare`]).
+impl Clone for Pyramid {
+    fn clone(&self) -> Self {
+        Self {
+            levels: self.levels.clone(),
+            bounds: self.bounds,
+            occupied: self.occupied.clone(),
+            seen: self.seen.clone(),
+            spare: clone_nested(&self.spare),
+            stamps: self.stamps.clone(),
+            changed: self.changed.clone(),
+            fresh: clone_vec(&self.fresh),
+            runs: clone_vec(&self.runs),
+            run_sums: clone_vec(&self.run_sums),
+        }
+    }
 }
 
 /// A parent cell that had no value when it was met.

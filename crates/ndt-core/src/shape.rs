@@ -120,6 +120,21 @@ pub struct ShapeMemo {
     runs: Vec<(RunKey, Vec<(CellKey, AncestorShape)>)>,
 }
 
+/// Empty, as the memo is between updates, with the original's storage: a
+/// copy's first updates then reuse it as the original's would
+/// ([`crate::spare`]).
+impl Clone for ShapeMemo {
+    fn clone(&self) -> Self {
+        let mut runs = Vec::with_capacity(self.runs.capacity());
+        runs.extend(
+            self.runs
+                .iter()
+                .map(|(key, shapes)| (*key, Vec::with_capacity(shapes.capacity()))),
+        );
+        Self { runs }
+    }
+}
+
 /// A shape level and the options its shapes depend on: its cell size, the σ
 /// floor and `k`, as bits.
 type RunKey = (u64, u64, u64);
@@ -135,6 +150,15 @@ pub struct ShapeReader<'m, 's> {
 }
 
 impl ShapeMemo {
+    /// The capacity of each kept run's storage (for tests of copies).
+    #[cfg(test)]
+    pub(crate) fn capacities(&self) -> Vec<usize> {
+        self.runs
+            .iter()
+            .map(|(_, shapes)| shapes.capacity())
+            .collect()
+    }
+
     /// Forgets every shape, keeping the storage for the next update's
     /// (each update's shapes grew new vectors: 0.4 % of an insert's
     /// instructions, BENCHMARK.md, "Speed", session 27). Runs of more than

@@ -20,6 +20,7 @@ use rustc_hash::FxHashMap;
 
 use crate::cell::Gaussian;
 use crate::key::CellKey;
+use crate::spare::clone_vec;
 use crate::table::{CellTable, Cursor};
 
 /// The covariance part of a distribution: everything but its mean.
@@ -74,7 +75,7 @@ pub enum Ancestor {
 }
 
 /// The distributions of one level with a shape level (see the module docs).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 pub struct ShapedStore {
     cells: CellTable<Entry>,
     parts: Vec<Part>,
@@ -82,6 +83,18 @@ pub struct ShapedStore {
     /// The ancestors that are [`Ancestor::Shaped`] or [`Ancestor::Blocked`]
     /// (absent: unshaped).
     ancestors: FxHashMap<CellKey, Ancestor>,
+}
+
+/// A copy with the original's spare capacity ([`crate::spare`]).
+impl Clone for ShapedStore {
+    fn clone(&self) -> Self {
+        Self {
+            cells: self.cells.clone(),
+            parts: clone_vec(&self.parts),
+            free: clone_vec(&self.free),
+            ancestors: self.ancestors.clone(),
+        }
+    }
 }
 
 impl ShapedStore {

@@ -18,6 +18,7 @@ use rustc_hash::FxHashMap;
 
 use crate::key::CellKey;
 use crate::parity::ParityMemo;
+use crate::spare::clone_vec;
 use crate::tiledir::{TileDirectory, NONE};
 
 /// log2 of the tile side \[cells\].
@@ -94,19 +95,13 @@ pub struct CellTable<T> {
 /// first insert after cloning reallocating and copying every value.
 impl<T: Clone> Clone for CellTable<T> {
     fn clone(&self) -> Self {
-        let mut values = Vec::with_capacity(self.values.capacity());
-        values.extend_from_slice(&self.values);
-        let mut keys = Vec::with_capacity(self.keys.capacity());
-        keys.extend_from_slice(&self.keys);
-        let mut slots = Vec::with_capacity(self.slots.capacity());
-        slots.extend_from_slice(&self.slots);
         Self {
             tiles: self.tiles.clone(),
-            slots,
-            used: self.used.clone(),
-            free_tiles: self.free_tiles.clone(),
-            values,
-            keys,
+            slots: clone_vec(&self.slots),
+            used: clone_vec(&self.used),
+            free_tiles: clone_vec(&self.free_tiles),
+            values: clone_vec(&self.values),
+            keys: clone_vec(&self.keys),
             inserted: self.inserted,
             dir: self.dir.clone(),
         }

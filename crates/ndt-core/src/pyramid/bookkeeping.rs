@@ -2,12 +2,14 @@
 //! of a level it has met ([`Stamps`]) and the indices of the values it
 //! changed ([`ChangedIndices`]), each kept between updates for its storage.
 
+use crate::spare::{clone_nested, clone_vec};
+
 /// Per level, the indices among the level's values of the cells the last
 /// update changed, in the order of the keys it returned for the level, while
 /// they hold: a new cell's value is pushed, so only a removal on that level
 /// moves one. The distributions' update then reads each changed cell's new
 /// sums without looking the cell up again.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 pub(super) struct ChangedIndices {
     /// Per level (reused between updates).
     levels: Vec<Vec<u32>>,
@@ -66,7 +68,7 @@ impl ChangedIndices {
 /// without a second look-up). The numbers are bytes: a byte a cell, and
 /// every 255 updates all marks are cleared once, so that no old mark equals
 /// a new number.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Default)]
 pub(super) struct Stamps {
     pub(super) call: u8,
     levels: Vec<Vec<u8>>,
@@ -116,5 +118,25 @@ impl Stamps {
     /// Bytes on the heap.
     pub(super) fn heap_bytes(&self) -> usize {
         self.levels.iter().map(Vec::capacity).sum()
+    }
+}
+
+/// A copy with the original's spare capacity ([`crate::spare`]).
+impl Clone for ChangedIndices {
+    fn clone(&self) -> Self {
+        Self {
+            levels: clone_nested(&self.levels),
+            valid: clone_vec(&self.valid),
+        }
+    }
+}
+
+/// A copy with the original's spare capacity ([`crate::spare`]).
+impl Clone for Stamps {
+    fn clone(&self) -> Self {
+        Self {
+            call: self.call,
+            levels: clone_nested(&self.levels),
+        }
     }
 }
