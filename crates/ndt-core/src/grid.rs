@@ -86,7 +86,7 @@ pub struct NdtGrid {
 impl Clone for NdtGrid {
     /// A copy with its coarser levels up to date (a copy made inside a
     /// deferral brings its own up to date at once), its storage with the
-    /// original's spare capacity ([`crate::spare`]): inserts into the copy
+    /// original's spare capacity (the `spare` module): inserts into the copy
     /// grow it as they would the original.
     fn clone(&self) -> Self {
         let mut copy = Self {

@@ -80,7 +80,7 @@ pub struct Pyramid {
 }
 
 /// A copy with the original's spare capacity, its reused storage included
-/// ([`crate::spare`]).
+/// (the `spare` module).
 impl Clone for Pyramid {
     fn clone(&self) -> Self {
         Self {

@@ -122,7 +122,7 @@ pub struct ShapeMemo {
 
 /// Empty, as the memo is between updates, with the original's storage: a
 /// copy's first updates then reuse it as the original's would
-/// ([`crate::spare`]).
+/// (the `spare` module).
 impl Clone for ShapeMemo {
     fn clone(&self) -> Self {
         let mut runs = Vec::with_capacity(self.runs.capacity());

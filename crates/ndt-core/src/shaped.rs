@@ -85,7 +85,7 @@ pub struct ShapedStore {
     ancestors: FxHashMap<CellKey, Ancestor>,
 }
 
-/// A copy with the original's spare capacity ([`crate::spare`]).
+/// A copy with the original's spare capacity (the `spare` module).
 impl Clone for ShapedStore {
     fn clone(&self) -> Self {
         Self {
