@@ -37,10 +37,8 @@ fn scan(beams: usize, pose: Pose2, seed: u64) -> Vec<[f64; 2]> {
 
 fn map(beams: usize, cell: f64) -> NdtGrid {
     let mut grid = NdtGrid::new(cell).unwrap_or_else(|e| panic!("{e}"));
-    for i in 0..8u32 {
-        let a = f64::from(i) * 0.8;
-        let pose = Pose2::new(0.3 * a.cos(), 0.2 * a.sin(), a);
-        grid.insert(&scan(beams, pose, u64::from(i)), pose)
+    for (pose, seed) in common::room_poses() {
+        grid.insert(&scan(beams, pose, seed), pose)
             .unwrap_or_else(|e| panic!("{e}"));
     }
     grid
@@ -174,10 +172,8 @@ fn bench_pyramid(c: &mut Criterion) {
     for cell in CELLS {
         for beams in BEAMS {
             let mut pyramid = Pyramid::new(cell, DEFAULT_LEVELS);
-            for i in 0..8u32 {
-                let a = f64::from(i) * 0.8;
-                let pose = Pose2::new(0.3 * a.cos(), 0.2 * a.sin(), a);
-                pyramid.add(&staged(&scan(beams, pose, u64::from(i)), pose, cell));
+            for (pose, seed) in common::room_poses() {
+                pyramid.add(&staged(&scan(beams, pose, seed), pose, cell));
             }
             let pose = Pose2::new(0.1, -0.05, 0.3);
             let batch = staged(&scan(beams, pose, 42), pose, cell);

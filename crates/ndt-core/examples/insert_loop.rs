@@ -30,10 +30,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     let rounds = arg(2, 300)?;
     let batch = arg(3, 1)?;
     let mut grid = NdtGrid::new(0.02)?;
-    for i in 0..8u32 {
-        let a = f64::from(i) * 0.8;
-        let pose = Pose2::new(0.3 * a.cos(), 0.2 * a.sin(), a);
-        grid.insert(&common::room_scan(beams, pose, u64::from(i)), pose)?;
+    for (pose, seed) in common::room_poses() {
+        grid.insert(&common::room_scan(beams, pose, seed), pose)?;
     }
     let ring: Vec<(Pose2, Vec<[f64; 2]>)> = (0..64u32)
         .map(|i| {

@@ -90,3 +90,12 @@ pub fn room_scan(beams: usize, pose: Pose2, seed: u64) -> Vec<[f64; 2]> {
     let fov = if beams >= 683 { 240f64 } else { 180f64 };
     scan(&room(), pose, beams, fov.to_radians(), 0.01, seed)
 }
+
+/// The 8 poses the benches build their maps of [`room`] from, each with the
+/// seed of its scan's noise.
+pub fn room_poses() -> impl Iterator<Item = (Pose2, u64)> {
+    (0..8u32).map(|i| {
+        let a = f64::from(i) * 0.8;
+        (Pose2::new(0.3 * a.cos(), 0.2 * a.sin(), a), u64::from(i))
+    })
+}
