@@ -12,18 +12,14 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
+#[path = "common/args.rs"]
+mod args;
+use args::arg;
+
 use std::error::Error;
 use std::time::Instant;
 
 use ndt_core::{MatchOptions, NdtGrid, Pose2};
-
-/// The `i`-th positional argument as a number, `default` when absent.
-fn arg(i: usize, default: usize) -> Result<usize, Box<dyn Error>> {
-    match std::env::args().nth(i) {
-        Some(s) => Ok(s.parse()?),
-        None => Ok(default),
-    }
-}
 
 fn main() -> Result<(), Box<dyn Error>> {
     let beams = arg(1, 683)?;

@@ -514,43 +514,19 @@ mod tests {
         }
     }
 
-    /// Three walls of a room, seen from `pose` (map-frame points mapped
-    /// into the scan's frame), with a few lone points.
-    fn walls(pose: Pose2, shift: f64) -> Vec<[f64; 2]> {
-        let mut map: Vec<[f64; 2]> = (0..300)
-            .map(|i| [-1.5 + 0.01 * f64::from(i) + shift, 1.0])
-            .collect();
-        map.extend((0..250).map(|i| [1.6, -1.2 + 0.009 * f64::from(i) + shift]));
-        map.extend((0..200).map(|i| [-1.7 + shift, -1.0 + 0.0105 * f64::from(i)]));
-        map.extend([[0.3 + shift, -0.7], [-0.4, 0.2 + shift]]);
-        let (s, c) = pose.theta.sin_cos();
-        map.iter()
-            .map(|[x, y]| {
-                let (dx, dy) = (x - pose.x, y - pose.y);
-                [c * dx + s * dy, -s * dx + c * dy]
-            })
-            .collect()
-    }
-
     #[test]
     fn a_clone_keeps_the_originals_storage_and_takes_an_insert_as_it_would() {
-        let mut grid = NdtGrid::new(0.02).unwrap();
-        for i in 0..6 {
-            let pose = Pose2::new(
-                0.05 * f64::from(i),
-                -0.03 * f64::from(i),
-                0.1 * f64::from(i),
-            );
-            grid.insert(&walls(pose, 0.004 * f64::from(i)), pose)
-                .unwrap();
-        }
+        use crate::testing::{room_map, room_scan};
+        use rand::SeedableRng;
+        let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+        let mut grid = room_map(&mut rng);
         // Prepared distributions of the default match, then one more insert,
         // as a loop makes them: the grid's vectors have spare capacity.
         let pose = Pose2::new(0.02, 0.01, 0.05);
-        let scan = walls(pose, 0.011);
+        let scan = room_scan(pose, &mut rng);
         grid.match_scan(&scan, pose, &crate::MatchOptions::default())
             .unwrap();
-        grid.insert(&walls(pose, 0.007), pose).unwrap();
+        grid.insert(&room_scan(pose, &mut rng), pose).unwrap();
         let mut copy = grid.clone();
         // Every vector's capacity counted by `heap_bytes` is the original's
         // (a derived clone's would be its length), and the reused storage of
@@ -560,7 +536,7 @@ mod tests {
         assert!(grid.shapes.capacities().iter().any(|&c| c > 0));
         // The same insert into both: the same sums and distributions.
         let pose = Pose2::new(-0.03, 0.02, -0.04);
-        let scan = walls(pose, 0.013);
+        let scan = room_scan(pose, &mut rng);
         grid.insert(&scan, pose).unwrap();
         copy.insert(&scan, pose).unwrap();
         crate::testing::assert_same_grids(&grid, &copy);

@@ -154,42 +154,13 @@ fn panic_error(payload: Box<dyn Any + Send>) -> NdtError {
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
+    use crate::testing::{room_map, room_scan};
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
 
-    /// A room's walls (4 × 3 m, a box inside) seen from `pose`: scan-frame points.
-    fn room_scan(pose: Pose2, rng: &mut StdRng) -> Vec<[f64; 2]> {
-        let mut world = Vec::new();
-        for i in 0..400 {
-            let t = f64::from(i) / 400.0;
-            world.push([-2.0 + 4.0 * t, -1.5]);
-            world.push([-2.0 + 4.0 * t, 1.5]);
-            world.push([-2.0, -1.5 + 3.0 * t]);
-            world.push([2.0, -1.5 + 3.0 * t]);
-            world.push([0.5 + 0.3 * t, 0.2]);
-        }
-        let (s, c) = pose.theta.sin_cos();
-        world
-            .iter()
-            .filter(|_| rng.random_range(0.0..1.0) < 0.35)
-            .map(|p| {
-                let (dx, dy) = (p[0] - pose.x, p[1] - pose.y);
-                [c * dx + s * dy, -s * dx + c * dy]
-            })
-            .collect()
-    }
-
     fn batch(n: usize) -> (NdtGrid, Vec<Vec<[f64; 2]>>, Vec<Pose2>) {
         let mut rng = StdRng::seed_from_u64(5);
-        let mut grid = NdtGrid::new(0.02).unwrap();
-        for k in 0..6 {
-            let at = Pose2::new(
-                0.1 * f64::from(k),
-                -0.05 * f64::from(k),
-                0.02 * f64::from(k),
-            );
-            grid.insert(&room_scan(at, &mut rng), at).unwrap();
-        }
+        let grid = room_map(&mut rng);
         let mut scans = Vec::new();
         let mut guesses = Vec::new();
         for i in 0..n {

@@ -66,3 +66,41 @@ pub(crate) fn assert_same_grids(a: &crate::NdtGrid, b: &crate::NdtGrid) {
         }
     }
 }
+
+/// A room's walls (4 × 3 m, a box inside) seen from `pose`: scan-frame
+/// points, about a third of them drawn by `rng`.
+pub(crate) fn room_scan(pose: crate::Pose2, rng: &mut StdRng) -> Vec<[f64; 2]> {
+    let mut world = Vec::new();
+    for i in 0..400 {
+        let t = f64::from(i) / 400.0;
+        world.push([-2.0 + 4.0 * t, -1.5]);
+        world.push([-2.0 + 4.0 * t, 1.5]);
+        world.push([-2.0, -1.5 + 3.0 * t]);
+        world.push([2.0, -1.5 + 3.0 * t]);
+        world.push([0.5 + 0.3 * t, 0.2]);
+    }
+    let (s, c) = pose.theta.sin_cos();
+    world
+        .iter()
+        .filter(|_| rng.random_range(0.0..1.0) < 0.35)
+        .map(|p| {
+            let (dx, dy) = (p[0] - pose.x, p[1] - pose.y);
+            [c * dx + s * dy, -s * dx + c * dy]
+        })
+        .collect()
+}
+
+/// A 2 cm grid of 6 [`room_scan`]s along a short path.
+#[allow(clippy::unwrap_used)]
+pub(crate) fn room_map(rng: &mut StdRng) -> crate::NdtGrid {
+    let mut grid = crate::NdtGrid::new(0.02).unwrap();
+    for k in 0..6 {
+        let at = crate::Pose2::new(
+            0.1 * f64::from(k),
+            -0.05 * f64::from(k),
+            0.02 * f64::from(k),
+        );
+        grid.insert(&room_scan(at, rng), at).unwrap();
+    }
+    grid
+}
