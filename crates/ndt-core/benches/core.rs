@@ -62,6 +62,9 @@ fn bench_insert_with(c: &mut Criterion, name: &str, prepared: bool) {
             // inserted first, as a loop inserts after every build: a freshly
             // built table is exactly full, and its first insert would copy it
             // whole (once per build in a loop, but on every timed clone here).
+            // A table that scan adds no cell to stays full: at 2 cm and 683
+            // points one level's 426 entries (32 bytes each) are copied by
+            // every timed insert (BENCHMARK.md, "Speed", session 51).
             let mut grid = grid;
             if prepared {
                 let _ = grid.match_scan(&pts, pose, &MatchOptions::default());
