@@ -55,8 +55,7 @@ fn bench_insert_with(c: &mut Criterion, name: &str, prepared: bool) {
     for cell in CELLS {
         for beams in BEAMS {
             let grid = map(beams, cell);
-            let pose = Pose2::new(0.1, -0.05, 0.3);
-            let pts = scan(beams, pose, 42);
+            let (pose, pts) = common::timed_scan(beams);
             // A SLAM loop's map has its distributions built: insert keeps them
             // up to date, and that is part of what is timed. One more scan is
             // inserted first, as a loop inserts after every build: a freshly
@@ -69,8 +68,8 @@ fn bench_insert_with(c: &mut Criterion, name: &str, prepared: bool) {
             if prepared {
                 let _ = grid.match_scan(&pts, pose, &MatchOptions::default());
             }
-            let before = Pose2::new(0.05, -0.02, 0.25);
-            grid.insert(&scan(beams, before, 43), before)
+            let (before, first) = common::before_scan(beams);
+            grid.insert(&first, before)
                 .unwrap_or_else(|e| panic!("{e}"));
             group.throughput(Throughput::Elements(pts.len() as u64));
             group.bench_with_input(
@@ -178,8 +177,8 @@ fn bench_pyramid(c: &mut Criterion) {
             for (pose, seed) in common::room_poses() {
                 pyramid.add(&staged(&scan(beams, pose, seed), pose, cell));
             }
-            let pose = Pose2::new(0.1, -0.05, 0.3);
-            let batch = staged(&scan(beams, pose, 42), pose, cell);
+            let (pose, pts) = common::timed_scan(beams);
+            let batch = staged(&pts, pose, cell);
             group.throughput(Throughput::Elements(batch.len() as u64));
             group.bench_with_input(
                 BenchmarkId::new(format!("cell_{}cm", cell * 100.0), beams),
@@ -224,8 +223,7 @@ fn bench_match_with(c: &mut Criterion, name: &str, options: &MatchOptions) {
     for cell in CELLS {
         for beams in BEAMS {
             let grid = map(beams, cell);
-            let truth = Pose2::new(0.1, -0.05, 0.3);
-            let pts = scan(beams, truth, 42);
+            let (truth, pts) = common::timed_scan(beams);
             let guess = Pose2::new(truth.x + 0.03, truth.y - 0.02, truth.theta + 0.017);
             // Build the distributions once, as a SLAM loop's map already has them.
             let _ = grid.match_scan(&pts, guess, options);

@@ -25,7 +25,7 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use insert_scans::median;
-use ndt_core::{MatchOptions, NdtGrid, Pose2};
+use ndt_core::{MatchOptions, NdtGrid};
 
 fn main() -> Result<(), Box<dyn Error>> {
     let beams = arg(1, 683)?;
@@ -34,11 +34,10 @@ fn main() -> Result<(), Box<dyn Error>> {
     for (pose, seed) in common::room_poses() {
         grid.insert(&common::room_scan(beams, pose, seed), pose)?;
     }
-    let pose = Pose2::new(0.1, -0.05, 0.3);
-    let points = common::room_scan(beams, pose, 42);
+    let (pose, points) = common::timed_scan(beams);
     grid.match_scan(&points, pose, &MatchOptions::default())?;
-    let before = Pose2::new(0.05, -0.02, 0.25);
-    grid.insert(&common::room_scan(beams, before, 43), before)?;
+    let (before, first) = common::before_scan(beams);
+    grid.insert(&first, before)?;
     let mut times = Vec::with_capacity(rounds);
     for _ in 0..rounds {
         let mut copy = grid.clone();

@@ -79,13 +79,13 @@ pub(crate) fn room_scan(pose: crate::Pose2, rng: &mut StdRng) -> Vec<[f64; 2]> {
         world.push([2.0, -1.5 + 3.0 * t]);
         world.push([0.5 + 0.3 * t, 0.2]);
     }
-    let (s, c) = pose.theta.sin_cos();
+    let to_scan = pose.inverse();
     world
         .iter()
         .filter(|_| rng.random_range(0.0..1.0) < 0.35)
         .map(|p| {
-            let (dx, dy) = (p[0] - pose.x, p[1] - pose.y);
-            [c * dx + s * dy, -s * dx + c * dy]
+            let q = to_scan.transform(nalgebra::Vector2::new(p[0], p[1]));
+            [q.x, q.y]
         })
         .collect()
 }

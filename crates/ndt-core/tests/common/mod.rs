@@ -99,3 +99,17 @@ pub fn room_poses() -> impl Iterator<Item = (Pose2, u64)> {
         (Pose2::new(0.3 * a.cos(), 0.2 * a.sin(), a), u64::from(i))
     })
 }
+
+/// The pose of the scan the benches time (insert, pyramid update, match), and
+/// the scan of `beams` beams seen from it.
+pub fn timed_scan(beams: usize) -> (Pose2, Vec<[f64; 2]>) {
+    let pose = Pose2::new(0.1, -0.05, 0.3);
+    (pose, room_scan(beams, pose, 42))
+}
+
+/// The scan the insert benches put into the map before their timed inserts,
+/// and its pose.
+pub fn before_scan(beams: usize) -> (Pose2, Vec<[f64; 2]>) {
+    let pose = Pose2::new(0.05, -0.02, 0.25);
+    (pose, room_scan(beams, pose, 43))
+}
