@@ -58,12 +58,12 @@ fn bench_insert_with(c: &mut Criterion, name: &str, prepared: bool) {
             let (pose, pts) = common::timed_scan(beams);
             // A SLAM loop's map has its distributions built: insert keeps them
             // up to date, and that is part of what is timed. One more scan is
-            // inserted first, as a loop inserts after every build: a freshly
-            // built table is exactly full, and its first insert would copy it
-            // whole (once per build in a loop, but on every timed clone here).
-            // A table that scan adds no cell to stays full: at 2 cm and 683
-            // points one level's 426 entries (32 bytes each) are copied by
-            // every timed insert (BENCHMARK.md, "Speed", session 51).
+            // inserted first, as a loop inserts after every build. Until
+            // session 52 a freshly built table was exactly full, and its
+            // first insert copied it whole (once per build in a loop, but on
+            // every timed clone here: at 2 cm and 683 points one level's 426
+            // entries); now a built table has the room of its level's sums
+            // (BENCHMARK.md, "Speed", sessions 51 and 52).
             let mut grid = grid;
             if prepared {
                 let _ = grid.match_scan(&pts, pose, &MatchOptions::default());

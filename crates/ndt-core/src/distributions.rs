@@ -92,9 +92,13 @@ impl Distributions {
         options: DistOptions,
         shape: Option<Shape<'_>>,
     ) -> Self {
+        // Room for as many cells as the level's sums have room for, not
+        // just for the cells there are: a table built exactly full copies
+        // itself whole at the first insert that adds a cell (session 52).
+        let room = cells.capacity();
         let store = match shape {
             None => {
-                let mut map = CellTable::with_capacity(cells.len());
+                let mut map = CellTable::with_capacity(room);
                 let keys: Vec<CellKey> = cells.keys().collect();
                 own_distributions(cells, cell_size, options, &keys, |key, g| {
                     if let Some(g) = g {
@@ -104,7 +108,7 @@ impl Distributions {
                 Store::Own(map)
             }
             Some(s) => {
-                let mut store = ShapedStore::with_capacity(cells.len());
+                let mut store = ShapedStore::with_capacity(room);
                 // Every ancestor's shape once, then every cell.
                 for at in s.cells().keys() {
                     store.set_ancestor(at, shape_of_ancestor(s, at, options));
@@ -237,6 +241,14 @@ impl Distributions {
         match &self.store {
             Store::Own(map) => map.len(),
             Store::Shaped(store) => store.len(),
+        }
+    }
+
+    /// Number of cells these distributions hold without reallocating.
+    pub fn capacity(&self) -> usize {
+        match &self.store {
+            Store::Own(map) => map.capacity(),
+            Store::Shaped(store) => store.capacity(),
         }
     }
 
@@ -834,6 +846,45 @@ mod tests {
             for key in cells.unwrap_or_default() {
                 assert_eq!(kept.get(key), built.get(key), "level {level} cell {key:?}");
             }
+        }
+    }
+
+    /// A level's distributions are built with the room its sums have: a table
+    /// built exactly full was copied whole by the first insert that added a
+    /// cell to the level, and by every insert into a fresh copy of a grid
+    /// (criterion's `insert` group; BENCHMARK.md, "Speed", session 52).
+    #[test]
+    fn a_built_table_has_the_room_of_its_sums_and_keeps_it_through_an_insert() {
+        for shape_cell in [0.32, 0.0] {
+            let options = DistOptions {
+                expansion: 10.0,
+                fuse_minority: true,
+                sigma_floor: 0.005,
+                shape_cell,
+            };
+            let mut grid = NdtGrid::new(0.02).unwrap();
+            // 100 fine cells, every other one along a line, 3 points each
+            // (a distribution of its own without a shape level).
+            let cell = |x: f64| [[x + 0.003, 0.004], [x + 0.009, 0.015], [x + 0.015, 0.009]];
+            let pts: Vec<[f64; 2]> = (0..100).flat_map(|i| cell(f64::from(i) * 0.04)).collect();
+            grid.insert(&pts, Pose2::identity()).unwrap();
+            let sums = grid.level(0).unwrap().cells();
+            let (cells, room) = (sums.len(), sums.capacity());
+            assert!(
+                room > cells,
+                "{room} > {cells}: the case needs room to spare"
+            );
+            let built = grid.distributions(0, options).unwrap();
+            assert_eq!(built.len(), cells, "shape_cell {shape_cell}");
+            assert_eq!(built.capacity(), room, "shape_cell {shape_cell}");
+            drop(built);
+            // Three points in a new cell between two others: the sums keep
+            // their room, and so do the distributions kept up to date.
+            grid.insert(&cell(0.02), Pose2::identity()).unwrap();
+            assert_eq!(grid.level(0).unwrap().cells().capacity(), room);
+            let kept = grid.distributions(0, options).unwrap();
+            assert_eq!(kept.len(), cells + 1, "shape_cell {shape_cell}");
+            assert_eq!(kept.capacity(), room, "shape_cell {shape_cell}");
         }
     }
 

@@ -239,6 +239,11 @@ impl ShapedStore {
         self.cells.len()
     }
 
+    /// Number of cells the store holds without reallocating its table.
+    pub fn capacity(&self) -> usize {
+        self.cells.capacity()
+    }
+
     /// `true` when no cell has a distribution.
     pub fn is_empty(&self) -> bool {
         self.cells.is_empty()

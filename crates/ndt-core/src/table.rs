@@ -150,6 +150,11 @@ impl<T> CellTable<T> {
         t
     }
 
+    /// Number of values the table holds without reallocating.
+    pub fn capacity(&self) -> usize {
+        self.values.capacity()
+    }
+
     /// Number of cells with a value.
     pub fn len(&self) -> usize {
         self.values.len()
