@@ -36,12 +36,7 @@ fn scan(beams: usize, pose: Pose2, seed: u64) -> Vec<[f64; 2]> {
 }
 
 fn map(beams: usize, cell: f64) -> NdtGrid {
-    let mut grid = NdtGrid::new(cell).unwrap_or_else(|e| panic!("{e}"));
-    for (pose, seed) in common::room_poses() {
-        grid.insert(&scan(beams, pose, seed), pose)
-            .unwrap_or_else(|e| panic!("{e}"));
-    }
-    grid
+    common::room_map(beams, cell).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn bench_insert(c: &mut Criterion) {

@@ -25,15 +25,12 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use insert_scans::median;
-use ndt_core::{MatchOptions, NdtGrid};
+use ndt_core::MatchOptions;
 
 fn main() -> Result<(), Box<dyn Error>> {
     let beams = arg(1, 683)?;
     let rounds = arg(2, 2000)?;
-    let mut grid = NdtGrid::new(0.02)?;
-    for (pose, seed) in common::room_poses() {
-        grid.insert(&common::room_scan(beams, pose, seed), pose)?;
-    }
+    let mut grid = common::room_map(beams, 0.02)?;
     let (pose, points) = common::timed_scan(beams);
     grid.match_scan(&points, pose, &MatchOptions::default())?;
     let (before, first) = common::before_scan(beams);

@@ -19,16 +19,13 @@ use args::arg;
 use std::error::Error;
 use std::time::Instant;
 
-use ndt_core::{MatchOptions, NdtGrid, Pose2};
+use ndt_core::{MatchOptions, Pose2};
 
 fn main() -> Result<(), Box<dyn Error>> {
     let beams = arg(1, 683)?;
     let rounds = arg(2, 300)?;
     let batch = arg(3, 1)?;
-    let mut grid = NdtGrid::new(0.02)?;
-    for (pose, seed) in common::room_poses() {
-        grid.insert(&common::room_scan(beams, pose, seed), pose)?;
-    }
+    let mut grid = common::room_map(beams, 0.02)?;
     let ring: Vec<(Pose2, Vec<[f64; 2]>)> = (0..64u32)
         .map(|i| {
             let a = f64::from(i) * std::f64::consts::TAU / 64.0;

@@ -2,7 +2,7 @@
 //! over line segments, so scans look like a real laser's.
 #![allow(dead_code)]
 
-use ndt_core::Pose2;
+use ndt_core::{NdtError, NdtGrid, Pose2};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -98,6 +98,16 @@ pub fn room_poses() -> impl Iterator<Item = (Pose2, u64)> {
         let a = f64::from(i) * 0.8;
         (Pose2::new(0.3 * a.cos(), 0.2 * a.sin(), a), u64::from(i))
     })
+}
+
+/// A grid of `cell` \[m\] holding the [`room_scan`]s of `beams` beams from
+/// [`room_poses`]: the map the benches and the profiling examples time on.
+pub fn room_map(beams: usize, cell: f64) -> Result<NdtGrid, NdtError> {
+    let mut grid = NdtGrid::new(cell)?;
+    for (pose, seed) in room_poses() {
+        grid.insert(&room_scan(beams, pose, seed), pose)?;
+    }
+    Ok(grid)
 }
 
 /// The pose of the scan the benches time (insert, pyramid update, match), and
