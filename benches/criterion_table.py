@@ -40,7 +40,7 @@ GRID_GROUPS = (
 CELLS = {"cell_2cm": "2 cm", "cell_20cm": "20 cm"}
 BEAMS = (180, 361, 683, 2000)
 BATCHES = (1, 4, 16, 64)
-LARGE = (8192, 16384, 32000)
+LARGE = (2048, 4096, 8192, 16384, 32000)
 ODOMETRY = ("181_beams_2cm", "181_beams_2cm_mapper_behind", "181_beams_2cm_poses_only")
 # Issue 7's targets that criterion times: (benchmark, limit [s], what).
 TARGETS = (

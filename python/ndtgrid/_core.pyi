@@ -392,13 +392,15 @@ class NdtGrid:
             solve with each ``k`` in turn (e.g. ``[100, 10, 1]``), each from the
             previous result; overrides ``expansion``.
         parallel : bool, default False
-            Score scans of at least 16384 points on all cores (rayon's pool;
-            ``RAYON_NUM_THREADS`` limits it), in fixed chunks of 2048 points
+            Score scans of at least 2048 points on all cores (rayon's pool;
+            ``RAYON_NUM_THREADS`` limits it), in fixed chunks of 512 points
             summed in order: the pose does not depend on the number of threads
             and differs from the one-thread result in the last bits. Off by
-            default: on 2 cores 16384 / 32000 points gained 1.26-1.42 / 1.44-1.50x (8192
-            did not), and Python threads matching different scans use the cores
-            better (the GIL is released). Rayon's pool starts with the first such
+            default, as Python threads matching different scans, or
+            ``match_many``, use the cores with less hand-over (the GIL is
+            released). On 2 cores 2048 / 8192 / 32000 points matched
+            1.31-1.39 / 1.76-1.81 / 1.65-1.79x faster than on one thread
+            (``cargo bench``). Rayon's pool starts with the first such
             match, one thread per CPU the calling thread may run on, on those
             CPUs, and keeps them: make that match on a thread not pinned to one
             CPU, or every later one runs on that CPU alone.

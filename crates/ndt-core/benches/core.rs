@@ -6,7 +6,7 @@
 //! The map is the synthetic room of the tests, built from eight scans; the
 //! matched scan is taken 3 cm / 1° away from its guess. `match` uses the
 //! default options (pyramid), `match_paper` the paper's method alone,
-//! `match_large` matches 8192-, 16384- and 32000-point scans (2 cm) with and without
+//! `match_large` matches 2048- to 32000-point scans (2 cm) with and without
 //! `MatchOptions::parallel`; `match_many` matches 64 different 683-point
 //! scans in one call on one thread and on every core (throughput in scans).
 //! `insert` keeps the prepared distributions of a default match up to date
@@ -240,7 +240,7 @@ fn bench_large(c: &mut Criterion) {
     let grid = map(2000, 0.02);
     let truth = Pose2::new(0.1, -0.05, 0.3);
     let guess = Pose2::new(truth.x + 0.03, truth.y - 0.02, truth.theta + 0.017);
-    for beams in [8192usize, 16384, 32000] {
+    for beams in [2048usize, 4096, 8192, 16384, 32000] {
         let pts = scan(beams, truth, 42);
         group.throughput(Throughput::Elements(pts.len() as u64));
         for parallel in [false, true] {

@@ -193,15 +193,20 @@ pub struct MatchOptions {
     /// (rayon's global pool: `RAYON_NUM_THREADS` limits it), in fixed chunks
     /// of [`PARALLEL_CHUNK`] points summed in order, so the result does not
     /// depend on the number of threads; it differs from the one-thread sum in
-    /// the last bits. Off by default: on 2 cores (`cargo bench --bench core --
-    /// match_large`, synthetic room, 2 cm) 16384 / 32000 points match 1.26–1.42
-    /// / 1.44–1.50× faster (two runs, session 5); 8192 points did not gain (hence the threshold), and with
-    /// 256-point chunks 2000 points were 2.3× slower (each of a match's ~40
-    /// evaluations wakes the pool). Python threads matching different scans
-    /// use the cores better (the GIL is released while matching). The pool
-    /// starts with the first such match and keeps the CPU affinity of the
-    /// thread that made it (one thread per CPU that thread may run on): made
-    /// from a thread pinned to one CPU, it has one thread, on that CPU.
+    /// the last bits. The match runs on a thread of the pool, and each chunk
+    /// streams its points as one thread streams a large scan. Off by default,
+    /// as Python threads matching different scans, and `match_many`, use the
+    /// cores with less hand-over (the GIL is released while matching). On 2
+    /// cores (`cargo bench --bench core -- match_large`, synthetic room, 2
+    /// cm, three runs in turn with the build before, session 53): 2048 /
+    /// 4096 / 8192 / 16384 / 32000 points matched 1.31–1.39 / 1.36–1.48 /
+    /// 1.76–1.81 / 1.70–1.84 / 1.65–1.79× faster than on one thread, where
+    /// the build before (chunks of 2048 points keeping their pairs, the pool
+    /// woken for each evaluation) was slower than one thread at 16384 and
+    /// 32000 points on the same VM. The pool starts with the first such match
+    /// and keeps the CPU affinity of the thread that made it (one thread per
+    /// CPU that thread may run on): made from a thread pinned to one CPU, it
+    /// has one thread, on that CPU.
     pub parallel: bool,
 }
 
@@ -220,11 +225,17 @@ pub struct MatchOptions {
 /// insert). BENCHMARK.md, "Speed", session 18.
 pub const DEFAULT_SKIP_LEVELS: u32 = 1 << 1;
 
-/// Smallest scan [`MatchOptions::parallel`] splits.
-pub const PARALLEL_MIN_POINTS: usize = 16384;
+/// Smallest scan [`MatchOptions::parallel`] splits: 1024 points gained
+/// nothing on 2 cores (`large_probe`, 0.094–0.102 against 0.095–0.146 ms),
+/// 2048 points 1.3–1.4× (session 53).
+pub const PARALLEL_MIN_POINTS: usize = 2048;
 
-/// Points per chunk of a parallel evaluation.
-pub const PARALLEL_CHUNK: usize = 2048;
+/// Points per chunk of a parallel evaluation: small enough that 2 threads
+/// share a scan of a few chunks evenly (chunks of 2048 points left 6144
+/// points slower on 2 threads than on one, 0.78–0.80 against 0.63–0.65 ms;
+/// 512: 0.37–0.38 ms), large enough that each is worth a task (256 points
+/// were 6 % slower at 32000 points). `large_probe`, session 53.
+pub const PARALLEL_CHUNK: usize = 512;
 
 impl Default for MatchOptions {
     fn default() -> Self {
@@ -410,9 +421,11 @@ const KEPT_LEVELS: usize = 2;
 
 /// The pairs of one set of (weighted) points kept during one match, for the
 /// last [`KEPT_LEVELS`] levels evaluated ([`crate::pairs`]): so that each
-/// evaluation looks up only the points that changed cell. With
-/// [`MatchOptions::parallel`] and a large scan they are kept in chunks of
-/// [`PARALLEL_CHUNK`] points, evaluated on all cores and summed in order.
+/// evaluation looks up only the points that changed cell. A scan of more
+/// than [`KEPT_MAX_POINTS`] points, or one that [`MatchOptions::parallel`]
+/// splits, keeps none: each evaluation streams its points, split into
+/// chunks of [`PARALLEL_CHUNK`] points on all cores and summed in order
+/// when parallel ([`evaluate_chunks`]).
 struct MatchPairs<'a> {
     points: &'a [[f64; 2]],
     weights: Option<&'a [f64]>,
@@ -420,7 +433,7 @@ struct MatchPairs<'a> {
     /// Pairs are kept (else every evaluation streams the points through a
     /// small block, [`evaluate_streaming`]).
     keep: bool,
-    kept: Vec<(usize, Vec<ScanPairs<'a>>)>,
+    kept: Vec<(usize, ScanPairs<'a>)>,
 }
 
 impl<'a> MatchPairs<'a> {
@@ -430,24 +443,23 @@ impl<'a> MatchPairs<'a> {
             points,
             weights,
             parallel,
-            keep: parallel || points.len() <= KEPT_MAX_POINTS,
+            keep: !parallel && points.len() <= KEPT_MAX_POINTS,
             kept: Vec::with_capacity(KEPT_LEVELS),
         }
     }
 
-    /// For a single evaluation: on one thread nothing kept (no storage for
-    /// the whole scan), the same terms.
+    /// For a single evaluation: nothing kept (no storage for the whole
+    /// scan), the same terms.
     fn once(points: &'a [[f64; 2]], options: &MatchOptions) -> Self {
-        let pairs = Self::new(points, None, options);
         Self {
-            keep: pairs.parallel,
-            ..pairs
+            keep: false,
+            ..Self::new(points, None, options)
         }
     }
 
     /// The kept pairs of `level`: those kept, else the coarsest level's
     /// (coarse to fine, it is done with), else new ones.
-    fn level(&mut self, level: usize) -> &mut Vec<ScanPairs<'a>> {
+    fn level(&mut self, level: usize) -> &mut ScanPairs<'a> {
         let at = match self.kept.iter().position(|(l, _)| *l == level) {
             Some(at) => at,
             None if self.kept.len() >= KEPT_LEVELS => {
@@ -460,20 +472,8 @@ impl<'a> MatchPairs<'a> {
                 coarsest
             }
             None => {
-                let chunk = if self.parallel {
-                    PARALLEL_CHUNK
-                } else {
-                    self.points.len().max(1)
-                };
-                let segments = self
-                    .points
-                    .chunks(chunk)
-                    .enumerate()
-                    .map(|(i, pts)| {
-                        ScanPairs::new(pts, chunk_weights(self.weights, i, chunk, pts.len()))
-                    })
-                    .collect();
-                self.kept.push((level, segments));
+                let pairs = ScanPairs::new(self.points, self.weights);
+                self.kept.push((level, pairs));
                 self.kept.len() - 1
             }
         };
@@ -504,28 +504,44 @@ impl<'a> MatchPairs<'a> {
             );
         }
         let radius = options.neighbor_search.then_some(options.search_radius);
-        if !self.keep {
-            return evaluate_streaming(
-                dists,
-                self.points,
-                self.weights,
-                pose,
-                inv_cell,
-                radius,
-                order,
-            );
+        if self.keep {
+            let pairs = self.level(dists.level());
+            return pairs.evaluate(dists, pose, inv_cell, radius, order);
         }
-        let segments = self.level(dists.level());
-        if let [one] = segments.as_mut_slice() {
-            return one.evaluate(dists, pose, inv_cell, radius, order);
+        let (points, weights) = (self.points, self.weights);
+        if !self.parallel {
+            return evaluate_streaming(dists, points, weights, pose, inv_cell, radius, order);
         }
-        use rayon::prelude::*;
-        let parts: Vec<PassTerms> = segments
-            .par_iter_mut()
-            .map(|s| s.evaluate(dists, pose, inv_cell, radius, order))
-            .collect();
-        sum_parts(&parts)
+        evaluate_chunks(points, weights, |chunk, w| {
+            evaluate_streaming(dists, chunk, w, pose, inv_cell, radius, order)
+        })
     }
+}
+
+/// The terms of a large scan's chunks of [`PARALLEL_CHUNK`] points
+/// (`chunk_terms` of each chunk's points and weights), on all cores, summed
+/// in order: the same bits whatever the number of threads. Streamed, as one
+/// thread streams a scan of more than [`KEPT_MAX_POINTS`] points: with each
+/// chunk's pairs kept instead, all chunks together no longer fit in the
+/// caches (`large_probe`, 32000 points, `RAYON_NUM_THREADS=1`, the pairs kept
+/// in chunks of 2048 points: 6.5–6.9 ms, against 4.3 ms streamed on one
+/// thread; BENCHMARK.md, "Speed", session 53).
+fn evaluate_chunks<F>(points: &[[f64; 2]], weights: Option<&[f64]>, chunk_terms: F) -> PassTerms
+where
+    F: Fn(&[[f64; 2]], Option<&[f64]>) -> PassTerms + Sync,
+{
+    use rayon::prelude::*;
+    let parts: Vec<PassTerms> = points
+        .par_chunks(PARALLEL_CHUNK)
+        .enumerate()
+        .map(|(i, chunk)| {
+            chunk_terms(
+                chunk,
+                chunk_weights(weights, i, PARALLEL_CHUNK, chunk.len()),
+            )
+        })
+        .collect();
+    sum_parts(&parts)
 }
 
 /// The terms of disjoint parts of a scan, summed in order.
@@ -558,16 +574,9 @@ fn evaluate_block(
     if !options.parallel || points.len() < PARALLEL_MIN_POINTS {
         return evaluate_block_serial(dists, points, weights, pose, inv_cell, options, order);
     }
-    use rayon::prelude::*;
-    let parts: Vec<PassTerms> = points
-        .par_chunks(PARALLEL_CHUNK)
-        .enumerate()
-        .map(|(i, chunk)| {
-            let w = chunk_weights(weights, i, PARALLEL_CHUNK, chunk.len());
-            evaluate_block_serial(dists, chunk, w, pose, inv_cell, options, order)
-        })
-        .collect();
-    sum_parts(&parts)
+    evaluate_chunks(points, weights, |chunk, w| {
+        evaluate_block_serial(dists, chunk, w, pose, inv_cell, options, order)
+    })
 }
 
 /// [`evaluate_block`] on one thread.
@@ -725,7 +734,30 @@ impl NdtGrid {
     /// [`NdtGrid::match_scan`] once its input is checked (`options` valid,
     /// [`NdtGrid::check_scan`] passed) on `levels` levels
     /// ([`NdtGrid::match_levels`]).
+    ///
+    /// A match that scores its scan on all cores ([`MatchOptions::parallel`])
+    /// runs on a thread of rayon's pool from start to end, which takes the
+    /// chunks of each evaluation with the pool's other threads: a thread
+    /// outside the pool would hand every evaluation to the pool and sleep
+    /// until it is done, a wake-up each way per evaluation, about 12 a
+    /// match (`large_probe`, 32000 points in chunks of 2048: 2.4–2.5 ms
+    /// against 2.6–3.1 ms; BENCHMARK.md, "Speed", session 53).
     pub(crate) fn match_checked(
+        &self,
+        points: &[[f64; 2]],
+        guess: Pose2,
+        options: &MatchOptions,
+        levels: usize,
+    ) -> Result<MatchResult> {
+        let parallel = options.parallel && points.len() >= PARALLEL_MIN_POINTS;
+        if parallel && rayon::current_thread_index().is_none() {
+            return rayon::scope(|_| self.coarse_to_fine(points, guess, options, levels));
+        }
+        self.coarse_to_fine(points, guess, options, levels)
+    }
+
+    /// [`NdtGrid::match_checked`] on the calling thread.
+    fn coarse_to_fine(
         &self,
         points: &[[f64; 2]],
         guess: Pose2,
