@@ -399,7 +399,7 @@ class NdtGrid:
             default, as Python threads matching different scans, or
             ``match_many``, use the cores with less hand-over (the GIL is
             released). On 2 cores 2048 / 8192 / 32000 points matched
-            1.31-1.39 / 1.76-1.81 / 1.65-1.79x faster than on one thread
+            1.31-1.39 / 1.76-1.85 / 1.65-1.79x faster than on one thread
             (``cargo bench``). Rayon's pool starts with the first such
             match, one thread per CPU the calling thread may run on, on those
             CPUs, and keeps them: make that match on a thread not pinned to one

@@ -199,11 +199,12 @@ pub struct MatchOptions {
     /// cores with less hand-over (the GIL is released while matching). On 2
     /// cores (`cargo bench --bench core -- match_large`, synthetic room, 2
     /// cm, three runs in turn with the build before, session 53): 2048 /
-    /// 4096 / 8192 / 16384 / 32000 points matched 1.31–1.39 / 1.36–1.48 /
-    /// 1.76–1.81 / 1.70–1.84 / 1.65–1.79× faster than on one thread, where
-    /// the build before (chunks of 2048 points keeping their pairs, the pool
-    /// woken for each evaluation) was slower than one thread at 16384 and
-    /// 32000 points on the same VM. The pool starts with the first such match
+    /// 4096 / 8192 / 16384 / 32000 points matched 1.31–1.39 / 1.41–1.48 /
+    /// 1.76–1.85 / 1.69–1.84 / 1.65–1.79× faster than on one thread, where
+    /// the build before (from 16384 points, in chunks of 2048 points keeping
+    /// their pairs, the pool woken for each evaluation) gave 0.81–0.92 /
+    /// 0.70–0.80× at 16384 / 32000 points in the same runs (1.20 / 1.36× in
+    /// session 52's `cargo bench`). The pool starts with the first such match
     /// and keeps the CPU affinity of the thread that made it (one thread per
     /// CPU that thread may run on): made from a thread pinned to one CPU, it
     /// has one thread, on that CPU.
@@ -367,6 +368,12 @@ impl MatchOptions {
         }
     }
 
+    /// Whether a scan of `points` points is scored on all cores
+    /// ([`MatchOptions::parallel`] and at least [`PARALLEL_MIN_POINTS`]).
+    fn splits(&self, points: usize) -> bool {
+        self.parallel && points >= PARALLEL_MIN_POINTS
+    }
+
     fn dist_options(&self) -> DistOptions {
         DistOptions {
             expansion: self.expansion,
@@ -438,7 +445,7 @@ struct MatchPairs<'a> {
 
 impl<'a> MatchPairs<'a> {
     fn new(points: &'a [[f64; 2]], weights: Option<&'a [f64]>, options: &MatchOptions) -> Self {
-        let parallel = options.parallel && points.len() >= PARALLEL_MIN_POINTS;
+        let parallel = options.splits(points.len());
         Self {
             points,
             weights,
@@ -571,7 +578,7 @@ fn evaluate_block(
     options: &MatchOptions,
     order: Order,
 ) -> PassTerms {
-    if !options.parallel || points.len() < PARALLEL_MIN_POINTS {
+    if !options.splits(points.len()) {
         return evaluate_block_serial(dists, points, weights, pose, inv_cell, options, order);
     }
     evaluate_chunks(points, weights, |chunk, w| {
@@ -749,8 +756,7 @@ impl NdtGrid {
         options: &MatchOptions,
         levels: usize,
     ) -> Result<MatchResult> {
-        let parallel = options.parallel && points.len() >= PARALLEL_MIN_POINTS;
-        if parallel && rayon::current_thread_index().is_none() {
+        if options.splits(points.len()) && rayon::current_thread_index().is_none() {
             return rayon::scope(|_| self.coarse_to_fine(points, guess, options, levels));
         }
         self.coarse_to_fine(points, guess, options, levels)
