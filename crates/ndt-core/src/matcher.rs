@@ -551,6 +551,17 @@ where
     sum_parts(&parts)
 }
 
+/// `work` on a thread of rayon's pool when `split` (a match that scores its
+/// scan on all cores) and the caller is not one already, else on the
+/// calling thread ([`NdtGrid::match_checked`] says why).
+fn on_pool<R: Send>(split: bool, work: impl FnOnce() -> R + Send) -> R {
+    if split && rayon::current_thread_index().is_none() {
+        rayon::scope(|_| work())
+    } else {
+        work()
+    }
+}
+
 /// The terms of disjoint parts of a scan, summed in order.
 fn sum_parts(parts: &[PassTerms]) -> PassTerms {
     let mut total = PassTerms {
@@ -756,10 +767,9 @@ impl NdtGrid {
         options: &MatchOptions,
         levels: usize,
     ) -> Result<MatchResult> {
-        if options.splits(points.len()) && rayon::current_thread_index().is_none() {
-            return rayon::scope(|_| self.coarse_to_fine(points, guess, options, levels));
-        }
-        self.coarse_to_fine(points, guess, options, levels)
+        on_pool(options.splits(points.len()), || {
+            self.coarse_to_fine(points, guess, options, levels)
+        })
     }
 
     /// [`NdtGrid::match_checked`] on the calling thread.
@@ -991,23 +1001,27 @@ impl NdtGrid {
         phases: &[f64],
         levels: usize,
     ) -> Result<MatchResult> {
-        let mut pose = guess;
-        let mut iterations = 0;
-        let mut last = None;
-        for &k in phases {
-            let opts = MatchOptions {
-                expansion: k,
-                ..*options
-            };
-            check_finite("guess", &pose.to_array())?;
-            let res = self.match_checked(points, pose, &opts, levels)?;
-            iterations += res.iterations;
-            pose = res.pose;
-            last = Some(res);
-        }
-        let mut res = last.ok_or(NO_PHASES)?;
-        res.iterations = iterations;
-        Ok(res)
+        // All phases on one thread of the pool when split (one hand-over,
+        // not one a phase; see `match_checked`).
+        on_pool(options.splits(points.len()), || {
+            let mut pose = guess;
+            let mut iterations = 0;
+            let mut last = None;
+            for &k in phases {
+                let opts = MatchOptions {
+                    expansion: k,
+                    ..*options
+                };
+                check_finite("guess", &pose.to_array())?;
+                let res = self.match_checked(points, pose, &opts, levels)?;
+                iterations += res.iterations;
+                pose = res.pose;
+                last = Some(res);
+            }
+            let mut res = last.ok_or(NO_PHASES)?;
+            res.iterations = iterations;
+            Ok(res)
+        })
     }
 
     /// `E(p)`, `∇(−E)` and `∇²(−E)` of eq. (1) for `points` at `pose`, without

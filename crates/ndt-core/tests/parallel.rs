@@ -4,7 +4,7 @@
 
 mod common;
 
-use ndt_core::{MatchOptions, NdtGrid, Pose2};
+use ndt_core::{MatchOptions, MatchResult, NdtGrid, Pose2};
 
 fn setup() -> (NdtGrid, Vec<[f64; 2]>, Pose2, Pose2) {
     setup_with(17000)
@@ -29,22 +29,53 @@ fn setup_with(points: usize) -> (NdtGrid, Vec<[f64; 2]>, Pose2, Pose2) {
     (grid, scan, guess, truth)
 }
 
+/// The default options with [`MatchOptions::parallel`].
+fn parallel() -> MatchOptions {
+    MatchOptions {
+        parallel: true,
+        ..MatchOptions::default()
+    }
+}
+
+/// `scan` matched with `options` on a pool of the caller's of `threads`
+/// threads.
+fn on_pool(
+    grid: &NdtGrid,
+    scan: &[[f64; 2]],
+    guess: Pose2,
+    options: &MatchOptions,
+    threads: usize,
+) -> MatchResult {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| grid.match_scan(scan, guess, options).unwrap())
+}
+
+/// `a`'s pose within 1e-9 of `b`'s, component by component.
+fn assert_same_pose(a: &MatchResult, b: &MatchResult) {
+    for (x, y) in [
+        (a.pose.x, b.pose.x),
+        (a.pose.y, b.pose.y),
+        (a.pose.theta, b.pose.theta),
+    ] {
+        assert!((x - y).abs() < 1e-9, "{x} vs {y}");
+    }
+}
+
+/// `r`'s position within 1 cm of the truth.
+fn assert_near(r: &MatchResult, truth: Pose2) {
+    assert!((r.pose.x - truth.x).abs() < 0.01 && (r.pose.y - truth.y).abs() < 0.01);
+}
+
 #[test]
 fn parallel_matches_do_not_depend_on_the_thread_count_and_agree_with_one_thread() {
     let (grid, scan, guess, truth) = setup();
     assert!(scan.len() >= ndt_core::matcher::PARALLEL_MIN_POINTS);
-    let parallel = MatchOptions {
-        parallel: true,
-        ..MatchOptions::default()
-    };
-    let on = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| grid.match_scan(&scan, guess, &parallel).unwrap())
-    };
-    let (one, two) = (on(1), on(2));
+    let parallel = parallel();
+    let one = on_pool(&grid, &scan, guess, &parallel, 1);
+    let two = on_pool(&grid, &scan, guess, &parallel, 2);
     assert_eq!(one, two);
     // From a thread outside any pool the match moves onto the global pool
     // (crate::matcher's `match_checked`): the same chunks, the same sum.
@@ -53,15 +84,9 @@ fn parallel_matches_do_not_depend_on_the_thread_count_and_agree_with_one_thread(
     let serial = grid
         .match_scan(&scan, guess, &MatchOptions::default())
         .unwrap();
-    for (a, b) in [
-        (one.pose.x, serial.pose.x),
-        (one.pose.y, serial.pose.y),
-        (one.pose.theta, serial.pose.theta),
-    ] {
-        assert!((a - b).abs() < 1e-9, "{a} vs {b}");
-    }
+    assert_same_pose(&one, &serial);
     assert!((one.score - serial.score).abs() < 1e-9 * serial.score);
-    assert!((one.pose.x - truth.x).abs() < 0.01 && (one.pose.y - truth.y).abs() < 0.01);
+    assert_near(&one, truth);
 }
 
 #[test]
@@ -72,12 +97,8 @@ fn a_scan_below_the_parallel_threshold_is_matched_on_one_thread_bit_for_bit() {
     let serial = grid
         .match_scan(&scan, guess, &MatchOptions::default())
         .unwrap();
-    let parallel = MatchOptions {
-        parallel: true,
-        ..MatchOptions::default()
-    };
-    assert_eq!(grid.match_scan(&scan, guess, &parallel).unwrap(), serial);
-    assert!((serial.pose.x - truth.x).abs() < 0.01 && (serial.pose.y - truth.y).abs() < 0.01);
+    assert_eq!(grid.match_scan(&scan, guess, &parallel()).unwrap(), serial);
+    assert_near(&serial, truth);
 }
 
 #[test]
@@ -85,24 +106,33 @@ fn a_scan_at_the_parallel_threshold_is_split_and_agrees_with_one_thread() {
     let at = ndt_core::matcher::PARALLEL_MIN_POINTS;
     let (grid, scan, guess, truth) = setup_with(at);
     assert_eq!(scan.len(), at);
-    let parallel = MatchOptions {
-        parallel: true,
-        ..MatchOptions::default()
-    };
+    let parallel = parallel();
     let split = grid.match_scan(&scan, guess, &parallel).unwrap();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
-    assert_eq!(
-        pool.install(|| grid.match_scan(&scan, guess, &parallel).unwrap()),
-        split
-    );
+    assert_eq!(on_pool(&grid, &scan, guess, &parallel, 2), split);
     let serial = grid
         .match_scan(&scan, guess, &MatchOptions::default())
         .unwrap();
-    assert!((split.pose.x - serial.pose.x).abs() < 1e-9);
-    assert!((split.pose.y - serial.pose.y).abs() < 1e-9);
-    assert!((split.pose.theta - serial.pose.theta).abs() < 1e-9);
-    assert!((split.pose.x - truth.x).abs() < 0.01 && (split.pose.y - truth.y).abs() < 0.01);
+    assert_same_pose(&split, &serial);
+    assert_near(&split, truth);
+}
+
+#[test]
+fn a_phased_parallel_match_does_not_depend_on_the_pool_it_runs_on() {
+    let (grid, scan, guess, truth) = setup_with(ndt_core::matcher::PARALLEL_MIN_POINTS);
+    let parallel = parallel();
+    let phases = [100.0, 10.0, 1.0];
+    // Its phases on one thread of the global pool (crate::matcher's
+    // `phased_checked`), against the same on a 1-thread pool of the caller's.
+    let global = grid.match_phased(&scan, guess, &parallel, &phases).unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let one = pool.install(|| grid.match_phased(&scan, guess, &parallel, &phases).unwrap());
+    assert_eq!(global, one);
+    let serial = grid
+        .match_phased(&scan, guess, &MatchOptions::default(), &phases)
+        .unwrap();
+    assert_same_pose(&global, &serial);
+    assert_near(&global, truth);
 }
