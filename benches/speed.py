@@ -30,7 +30,9 @@ as a Markdown table to stdout as soon as it is measured (progress goes to stderr
 5. **Threads**: matches per second of two Python threads matching different scans
    against one grid, against one thread, twice: threads started for each run where the
    kernel puts them, and two long-lived worker threads pinned to the two cores
-   (``benches/pinned.py``); the same scans in one ``NdtGrid.match_many`` call on one
+   (``benches/pinned.py``); then threads that keep matching for a second a round,
+   started where the kernel puts them (``benches/steady.py``), as a SLAM loop's threads
+   live; the same scans in one ``NdtGrid.match_many`` call on one
    thread and on every core; two GIL-free controls in the same run (SHA-256, and our
    matcher on bundles of 20 scans merged into one, whose calls are long enough that the
    GIL hardly matters); in how many runs the kernel had both unpinned threads on one
@@ -86,6 +88,7 @@ import datasets
 import peers as peer_lib
 import pinned
 import speed_plots
+import steady
 
 import ndtgrid
 from ndtgrid import se2, sim
@@ -1534,6 +1537,13 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     bundle_1, bundle_2 = [], []
     pin_1, pin_2, pin_lates, pin_cpu1, pin_cpu2 = [], [], [], [], []
     many_1, many_2, many_cpu = [], [], []
+    steady_1: list[steady.SteadyRun] = []
+    steady_2: list[steady.SteadyRun] = []
+
+    def match_job(i: int) -> None:
+        p, g = jobs[i % len(jobs)]
+        grid.match(p, g)
+
     same = True
     try:
         for rep in progress(range(args.thread_reps), "threads"):
@@ -1580,6 +1590,14 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             many_2.append(t2)
             many_cpu.append(c2)
             same &= all(np.array_equal(a, b) for a, b in zip(base + base, r1 + r2))
+        # Threads that keep matching the same scans (round and round) for
+        # args.steady_seconds, one thread then two, started where the kernel puts them
+        # (benches/steady.py): a SLAM loop's threads live for the whole run, so where the
+        # kernel starts them weighs little. Last, so the runs above are timed as before.
+        for _ in progress(range(args.steady_reps), "threads that keep matching"):
+            with no_gc():
+                steady_1.append(steady.keep_matching(match_job, 1, args.steady_seconds))
+                steady_2.append(steady.keep_matching(match_job, 2, args.steady_seconds))
     finally:
         if workers is not None:
             workers.close()
@@ -1593,6 +1611,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "pinned": list(np.divide(pin_1, pin_2)),
         "bundles": list(np.divide(bundle_1, bundle_2)),
         "many": list(np.divide(many_1, many_2)),
+        "steady": [b.rate / a.rate for a, b in zip(steady_1, steady_2)],
     }
 
     def split_by(flags: list[bool | None]) -> tuple[list[float], list[float], int, list[float]]:
@@ -1633,6 +1652,38 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     mm1, mm2 = n / np.median(many_1), n / np.median(many_2)
     mb1, mb2 = n / min(many_1), n / min(many_2)
     many_ratio, many_best = mm2 / max(mm1, s1), mb2 / max(mb1, b1)
+    # Threads that keep matching, against the faster one-thread row too.
+    st1 = float(np.median([r.rate for r in steady_1])) if steady_1 else math.nan
+    st2 = float(np.median([r.rate for r in steady_2])) if steady_2 else math.nan
+    sb1 = max((r.rate for r in steady_1), default=math.nan)
+    sb2 = max((r.rate for r in steady_2), default=math.nan)
+    steady_ratio, steady_best = st2 / max(st1, s1), sb2 / max(sb1, b1)
+    if steady_1:
+        steady_rows = [
+            f"| 1, keeps matching for {args.steady_seconds:g} s | {st1:.0f} | {sb1:.0f} "
+            f"| {np.median([r.cpu_over_wall for r in steady_1]):.2f} |",
+            f"| 2, keep matching for {args.steady_seconds:g} s | {st2:.0f} | {sb2:.0f} "
+            f"| {np.median([r.cpu_over_wall for r in steady_2]):.2f} |",
+            f"| ratio, threads that keep matching (against the faster one-thread row) "
+            f"| {steady_ratio:.2f}× | {steady_best:.2f}× | |",
+        ]
+        steady_text = [
+            "",
+            f"Threads that keep matching: {args.steady_reps} rounds after the rest, each "
+            "one thread and then two, started where the kernel puts them (not pinned), "
+            f"matching the same {n} scans round and round for {args.steady_seconds:g} s "
+            "(`benches/steady.py`; each thread ends with the match it is in when the time "
+            "is up; rate: the matches over the time from the start to the last thread's "
+            "end). A SLAM loop's threads live for the whole run, so where the kernel "
+            "starts them weighs little here, unlike in the runs above, of "
+            f"{n // 2} matches a thread. The ratio is taken against the faster of this "
+            "row's one thread and the first row. Per round (two threads' rate over one's "
+            "right before it): "
+            f"{', '.join(f'{r:.2f}' for r in per_run['steady'])}; matches per thread "
+            f"with two: {', '.join('/'.join(map(str, r.calls)) for r in steady_2)}.",
+        ]
+    else:
+        steady_rows, steady_text = [], []
     if pin_1 and cpus is not None:
         # Judged against the faster of the two one-thread baselines (pinned, cores in
         # turn; unpinned, where the kernel put it), so that a slow core alone cannot
@@ -1690,6 +1741,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             f"| {np.median(many_cpu):.2f} |",
             f"| ratio, `match_many` (against the faster one-thread row) | {many_ratio:.2f}× "
             f"| {many_best:.2f}× | |",
+            *steady_rows,
             "",
             "Per run (one thread's time over the two threads' time right after it): "
             f"{', '.join(f'{r:.2f}' for r in per_run['unpinned'])}; median "
@@ -1736,6 +1788,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             "right after it): "
             f"{', '.join(f'{r:.2f}' for r in per_run['many'])}; median "
             f"{float(np.median(per_run['many'])):.2f}×.",
+            *steady_text,
         ]
     )
     if args.plot_threads:
@@ -1761,6 +1814,9 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "bundle_ratio": bundle_ratio,
         "many_ratio": many_ratio,
         "many_ratio_best": many_best,
+        "steady_ratio": steady_ratio,
+        "steady_ratio_best": steady_best,
+        "steady_seconds": args.steady_seconds,
         "one_cpu_runs": len(together) if known else None,
         "one_cpu_first_runs": len(first_together) if first else None,
         "cpu_read_runs": known,
@@ -1769,7 +1825,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         # lists of them by place are left out, the flags below give them), the second
         # thread's start after the clock (s), and whether the two threads were on one
         # vCPU at their first matches and half-way through (None: not read).
-        "per_run": {k: per_run[k] for k in ("unpinned", "pinned", "bundles", "many")},
+        "per_run": {k: per_run[k] for k in ("unpinned", "pinned", "bundles", "many", "steady")},
         "late_s": lates,
         "one_cpu_first": shared_first,
         "one_cpu_half": shared,
@@ -1986,6 +2042,15 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
             else f"{pr:.2f}× (best runs {t['pinned_ratio_best']:.2f}×)",
             None if math.isnan(pr) else pr >= 1.7,
         )
+        sr = t.get("steady_ratio", math.nan)
+        row(
+            "two threads ≥ 1.7× one, threads that keep matching "
+            f"({t.get('steady_seconds', math.nan):g} s rounds, placed by the kernel)",
+            "not measured"
+            if math.isnan(sr)
+            else f"{sr:.2f}× (best rounds {t['steady_ratio_best']:.2f}×)",
+            None if math.isnan(sr) else sr >= 1.7,
+        )
         row(
             "one `match_many` call on every core ≥ 1.7× one thread (the library's own "
             "threads, not Python's)",
@@ -2064,6 +2129,8 @@ def main() -> int:
     args.sweep_copies = [0, 2] if q else [0, 1, 4, 16]
     args.thread_matches = 100 if q else 600
     args.thread_reps = 3 if q else 21
+    args.steady_reps = 2 if q else 5
+    args.steady_seconds = 0.2 if q else 1.0
     args.memory_copies = [1, 2] if q else [1, 2, 4, 8]
 
     if args.intel_child:

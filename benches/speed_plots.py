@@ -83,7 +83,8 @@ def plot_threads(
     ratio (one thread's time over two threads' right after it) for the unpinned threads
     (ringed where both were on one vCPU at their first matches, dotted where they were
     half-way through; ``nan`` elsewhere in those two lists) and the pinned ones,
-    ``match_many`` and the two GIL-free controls; when the later thread began, with a
+    ``match_many``, threads that keep matching (``steady``: two threads' rate over one's,
+    per round) and the two GIL-free controls; when the later thread began, with a
     line at ``late_start`` (s), where the section splits its runs into late and not.
     Its path, or ``None`` without matplotlib."""
     plt = pyplot()
@@ -99,6 +100,7 @@ def plot_threads(
         ("sha", "x", "control: SHA-256 (GIL released)", {}),
         ("bundles", "+", "control: 20-scan bundles", {}),
         ("many", "D", "match_many, every core / one thread", {}),
+        ("steady", "^", "two threads that keep matching (rounds)", {}),
     ):
         ys = runs.get(key, [])
         if ys:

@@ -59,9 +59,12 @@ def test_the_thread_section_as_json(tmp_path: Path) -> None:
     # --quick: three one- and two-thread runs, each with its ratio, start and CPUs.
     runs = len(t["late_s"])
     assert runs == 3
-    assert set(t["per_run"]) == {"unpinned", "pinned", "bundles", "many"}
+    assert set(t["per_run"]) == {"unpinned", "pinned", "bundles", "many", "steady"}
     for key in ("unpinned", "bundles", "many"):
         assert len(t["per_run"][key]) == runs
+    # --quick: two rounds of threads that keep matching for 0.2 s.
+    assert len(t["per_run"]["steady"]) == 2
+    assert t["steady_seconds"] == 0.2
     # Pinned workers need two CPUs; without them their ratio is NaN, null in the JSON.
     pinned = t["pinned_ratio"] is not None
     assert len(t["per_run"]["pinned"]) == (runs if pinned else 0)
@@ -75,6 +78,13 @@ def test_the_thread_section_as_json(tmp_path: Path) -> None:
     assert row is not None
     assert row.group(1) == f"{t['ratio']:.2f}"
     assert f"late in {t['late_runs']} of {runs} runs)" in proc.stdout
+    steady = re.search(
+        rf"\| two threads ≥ 1\.7{times} one, threads that keep matching \(0\.2 s rounds, "
+        rf"placed by the kernel\) \| ([\d.]+){times} \(best rounds ([\d.]+){times}\)",
+        proc.stdout,
+    )
+    assert steady is not None
+    assert steady.groups() == (f"{t['steady_ratio']:.2f}", f"{t['steady_ratio_best']:.2f}")
     assert f"Results as JSON: `{path}`." in proc.stdout
 
 
