@@ -30,10 +30,10 @@ as a Markdown table to stdout as soon as it is measured (progress goes to stderr
 5. **Threads**: matches per second of two Python threads matching different scans
    against one grid, against one thread, twice: threads started for each run where the
    kernel puts them, and two long-lived worker threads pinned to the two cores
-   (``benches/pinned.py``); then threads that keep matching for a second a round,
+   (``benches/pinned.py``); the same scans in one ``NdtGrid.match_many`` call on one
+   thread and on every core; last, threads that keep matching for a second a round,
    started where the kernel puts them (``benches/steady.py``), as a SLAM loop's threads
-   live; the same scans in one ``NdtGrid.match_many`` call on one
-   thread and on every core; two GIL-free controls in the same run (SHA-256, and our
+   live; two GIL-free controls in the same run (SHA-256, and our
    matcher on bundles of 20 scans merged into one, whose calls are long enough that the
    GIL hardly matters); in how many runs the kernel had both unpinned threads on one
    vCPU half-way through; each run's ratios and late starts in
