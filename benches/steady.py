@@ -83,9 +83,8 @@ def keep_matching(task: Callable[[int], object], threads: int, seconds: float) -
         raise ValueError(f"seconds: expected more than 0, got {seconds!r}")
     calls = [0] * threads
     errors: list[BaseException] = []
-    stop_at = 0.0
 
-    def work(k: int) -> None:
+    def work(k: int, stop_at: float) -> None:
         i, done = k, 0
         try:
             while time.perf_counter() < stop_at and not errors:
@@ -96,9 +95,8 @@ def keep_matching(task: Callable[[int], object], threads: int, seconds: float) -
             errors.append(e)
         calls[k] = done
 
-    workers = [threading.Thread(target=work, args=(k,)) for k in range(threads)]
     c0, t0 = time.process_time(), time.perf_counter()
-    stop_at = t0 + seconds
+    workers = [threading.Thread(target=work, args=(k, t0 + seconds)) for k in range(threads)]
     for w in workers:
         w.start()
     for w in workers:
