@@ -44,7 +44,8 @@ as a Markdown table to stdout as soon as it is measured (progress goes to stderr
 Sections 1-3 are then drawn in one picture, ``docs/img/speed_peers.png`` when matplotlib
 is installed: every method's median match per case set with its success rate, every
 map's update of one scan, every loop's time over the Intel log with its relation error.
-A table of the issue's targets against this run's numbers closes the output.
+A table of the issue's targets (their limits in ``benches/targets.py``) against this
+run's numbers closes the output; ``benches/speed_runs.py`` tables many runs' ``--json``.
 
 Run from the repository root (needs ``pip install -e ".[bench]"`` and
 ``../shared/data/real``; Open3D's wheel also needs the system's ``libusb-1.0``, on
@@ -89,6 +90,7 @@ import peers as peer_lib
 import pinned
 import speed_plots
 import steady
+import targets as tg
 
 import ndtgrid
 from ndtgrid import se2, sim
@@ -1936,7 +1938,7 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
                 f"median match ≤ 0.2 ms ({label} scan, {m[key]['points']:.0f} points median, "
                 "2 cm map of 20 scans)",
                 f"{ms(v)} ms",
-                v <= 2e-4,
+                v <= tg.MATCH_S,
             )
     if "≥ 500" in m.get("urg_log", {}):
         v, npts = m["urg_log"]["≥ 500"]
@@ -1944,7 +1946,7 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
             f"median match ≤ 0.2 ms (real URG-04LX scans with ≥ 500 points, {npts:.0f} "
             "median, 2 cm map of 20 scans)",
             f"{ms(v)} ms",
-            v <= 2e-4,
+            v <= tg.MATCH_S,
         )
     for key, label in (
         ("sick", "real SICK pairs"),
@@ -1961,23 +1963,23 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
                 value += f"; at ≥ our success: {gt / m[key]['ours']:.2f}× ({gname})"
             else:
                 value += "; no peer at ≥ our success"
-            row(f"≥ 3× faster than the fastest peer ({label})", value, r >= 3)
+            row(f"≥ 3× faster than the fastest peer ({label})", value, r >= tg.PEER_RATIO)
     ins = res.get("insert", {})
     for title, v in ins.items():
         row(
             f"insert ≤ 50 µs ({title}, {v['points']:.0f} points)",
             f"{us(v['ours'])} µs",
-            v["ours"] <= 50e-6 if v["points"] >= 500 else None,
+            v["ours"] <= tg.INSERT_S if v["points"] >= tg.INSERT_MIN_POINTS else None,
         )
     o = res.get("odometry", {})
     if o:
-        full = o["scans"] >= 13631
+        full = o["scans"] >= tg.INTEL_SCANS
         row(
             f"Intel log through `Odometry` ≤ 3 s ({o['scans']} scans)",
             f"{o['ours']:.2f} s ({1e3 * o['ours'] / o['scans']:.3f} ms / scan), median of "
             f"{len(o['ours_runs'])} runs: {', '.join(f'{t:.2f}' for t in o['ours_runs'])} s; "
             f"one thread {o['ours_one_thread']:.2f} s; poses only {o['ours_poses_only']:.2f} s",
-            o["ours"] <= 3.0 if full else None,
+            o["ours"] <= tg.INTEL_S if full else None,
         )
         for key, label in (
             ("fastest", "odometry ≥ 3× faster than the fastest peer"),
@@ -1991,7 +1993,7 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
                     label,
                     f"{t / o['ours']:.2f}× ({name}); one thread {one:.2f}×; poses only "
                     f"(`build_map=False`) {bare:.2f}×",
-                    t / o["ours"] >= 3,
+                    t / o["ours"] >= tg.PEER_RATIO,
                 )
         if "fastest_good" not in o and "fastest" in o:
             row(
@@ -2004,7 +2006,9 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
     if "points" in s:
         _, slope, _, r2 = s["points"]
         row(
-            "time linear in scan points", f"R² = {r2:.3f}, {1e6 * slope:.3f} µs / point", r2 >= 0.95
+            "time linear in scan points",
+            f"R² = {r2:.3f}, {1e6 * slope:.3f} µs / point",
+            r2 >= tg.LINEAR_R2,
         )
     for kind in ("map_recent", "map_padded"):
         if kind in s:
@@ -2014,7 +2018,7 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
                 f"time does not grow with map size ({kind[4:]} maps, "
                 f"{sub[0]['cells']:.0f} → {sub[-1]['cells']:.0f} cells)",
                 f"{g:.2f}× the time",
-                g <= 1.2,
+                g <= tg.FLAT_GROWTH,
             )
     t = res.get("threads", {})
     if t:
@@ -2032,7 +2036,7 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
             )
             + f"; the second thread {1e3 * LATE_START:.0f} ms or more late in "
             f"{t['late_runs']} of {len(t['late_s'])} runs)",
-            t["ratio"] >= 1.7,
+            t["ratio"] >= tg.THREADS_RATIO,
         )
         pr = t.get("pinned_ratio", math.nan)
         row(
@@ -2040,7 +2044,7 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
             "not measured"
             if math.isnan(pr)
             else f"{pr:.2f}× (best runs {t['pinned_ratio_best']:.2f}×)",
-            None if math.isnan(pr) else pr >= 1.7,
+            None if math.isnan(pr) else pr >= tg.THREADS_RATIO,
         )
         sr = t.get("steady_ratio", math.nan)
         row(
@@ -2049,13 +2053,13 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
             "not measured"
             if math.isnan(sr)
             else f"{sr:.2f}× (best rounds {t['steady_ratio_best']:.2f}×)",
-            None if math.isnan(sr) else sr >= 1.7,
+            None if math.isnan(sr) else sr >= tg.THREADS_RATIO,
         )
         row(
             "one `match_many` call on every core ≥ 1.7× one thread (the library's own "
             "threads, not Python's)",
             f"{t['many_ratio']:.2f}× (best runs {t['many_ratio_best']:.2f}×)",
-            t["many_ratio"] >= 1.7,
+            t["many_ratio"] >= tg.THREADS_RATIO,
         )
     mem = res.get("memory", {})
     if mem:

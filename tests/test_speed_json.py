@@ -86,6 +86,13 @@ def test_the_thread_section_as_json(tmp_path: Path) -> None:
     assert steady is not None
     assert steady.groups() == (f"{t['steady_ratio']:.2f}", f"{t['steady_ratio_best']:.2f}")
     assert f"Results as JSON: `{path}`." in proc.stdout
+    # benches/speed_runs.py tables the document: the threads row judges what it holds.
+    speed_runs = load_bench("speed_runs")
+    lines = speed_runs.run_tables([speed_runs.read_run(path)], columns=8)
+    (started,) = [line for line in lines if "started for each run" in line]
+    cells = [c.strip() for c in started.strip("|").split("|")]
+    assert cells[1].endswith(f"({t['control']:.2f}; {t['bundle_ratio']:.2f})")
+    assert cells[2] == ("1 of 1" if t["ratio"] >= 1.7 else "0 of 1")
 
 
 def test_a_run_stopped_part_way_keeps_the_sections_it_ran(

@@ -1,0 +1,400 @@
+"""Many ``benches/speed.py --json`` runs as BENCHMARK.md's per-run tables:
+``python benches/speed_runs.py RUN.json [RUN.json ...]``.
+
+Each run is a column, named by the first number in its file's name (``run539.json``:
+539), else by the name; each of issue 7's targets is a row (``benches/targets.py``
+holds the limits, the judging is ``speed.py``'s), with how many runs met it. A number
+that misses its target is in bold, with one more digit when it rounds onto the limit
+(a ratio of 1.695 is no 1.70). Tables of at most ``--columns`` runs; then, over all the runs,
+each row's range and count, and the runs that met every target. A section a run did
+not time reads as a dash and is not judged; such a run did not meet every target.
+
+Run from the repository root, e.g.::
+
+    python benches/speed.py --json /tmp/run1.json   # as many times as wanted
+    python benches/speed_runs.py /tmp/run*.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import targets as tg
+
+Sections = dict[str, Any]
+
+
+@dataclass(frozen=True)
+class Part:
+    """One number of a cell: ``value`` printed with ``digits`` decimals (``None``: not
+    measured), judged against ``limit`` (``None``: not judged), which it must reach
+    (``at_least``) or not exceed."""
+
+    value: float | None
+    digits: int
+    limit: float | None = None
+    at_least: bool = False
+
+    def met(self) -> bool | None:
+        """Whether the number meets its limit; ``None`` where either is missing."""
+        if self.value is None or self.limit is None:
+            return None
+        return self.value >= self.limit if self.at_least else self.value <= self.limit
+
+    def text(self) -> str:
+        """The number as printed (bold when it misses)."""
+        if self.value is None:
+            return "–"
+        s = f"{self.value:.{self.digits}f}"
+        if self.met() is False:
+            if self.limit is not None and float(s) == self.limit:
+                s = f"{self.value:.{self.digits + 1}f}"
+            return f"**{s}**"
+        return s
+
+
+@dataclass(frozen=True)
+class Cell:
+    """A row's numbers for one run, ``{}`` in ``template`` standing for each part."""
+
+    template: str
+    parts: tuple[Part, ...]
+
+    def met(self) -> bool | None:
+        """Whether every judged part meets its limit; ``None`` when none is judged."""
+        verdicts = [v for v in (p.met() for p in self.parts) if v is not None]
+        return all(verdicts) if verdicts else None
+
+    def text(self) -> str:
+        """The cell as printed."""
+        return self.template.format(*(p.text() for p in self.parts))
+
+
+@dataclass(frozen=True)
+class Row:
+    """A row of the tables: its name, whether it is a target (else it only informs),
+    and its cell for a run's sections (``None``: the run did not time it)."""
+
+    name: str
+    target: bool
+    cell: Callable[[Sections], Cell | None]
+
+
+def _get(d: Any, *keys: str | int) -> Any:
+    """``d[k0][k1]…``, or ``None`` where a key is missing or a value is null."""
+    for k in keys:
+        if isinstance(d, dict):
+            d = d.get(k)
+        elif isinstance(d, list) and isinstance(k, int) and -len(d) <= k < len(d):
+            d = d[k]
+        else:
+            return None
+        if d is None:
+            return None
+    return d
+
+
+def _scaled(v: Any, scale: float) -> float | None:
+    return None if v is None else float(v) * scale
+
+
+def _ratio(num: Any, den: Any) -> float | None:
+    return None if num is None or den is None else float(num) / float(den)
+
+
+def _match(s: Sections) -> Cell | None:
+    m = s.get("match")
+    if not m:
+        return None
+    limit = tg.MATCH_S * 1e3
+    times = (
+        _get(m, "sim_map", "ours"),
+        _get(m, "urg_map", "ours"),
+        _get(m, "urg_log", "≥ 500", 0),
+    )
+    return Cell("{} / {} / {}", tuple(Part(_scaled(t, 1e3), 3, limit) for t in times))
+
+
+PEER_CASES = ("sick", "urg_pairs", "urg_map", "sim_map")
+
+
+def _peers(s: Sections) -> Cell | None:
+    m = s.get("match")
+    if not m:
+        return None
+    ratios = (_ratio(_get(m, k, "fastest", 1), _get(m, k, "ours")) for k in PEER_CASES)
+    return Cell("{} / {} / {} / {}×", tuple(Part(r, 2, tg.PEER_RATIO, True) for r in ratios))
+
+
+def _insert(s: Sections) -> Cell | None:
+    judged = [
+        v for v in (s.get("insert") or {}).values() if v.get("points", 0) >= tg.INSERT_MIN_POINTS
+    ]
+    if not judged:
+        return None
+    parts = tuple(Part(_scaled(v.get("ours"), 1e6), 1, tg.INSERT_S * 1e6) for v in judged)
+    return Cell(" / ".join("{}" for _ in parts), parts)
+
+
+def _intel(s: Sections) -> Cell | None:
+    o = s.get("odometry")
+    if not o:
+        return None
+    full = o.get("scans", 0) >= tg.INTEL_SCANS
+    return Cell(
+        "{} ({})",
+        (
+            Part(o.get("ours"), 2, tg.INTEL_S if full else None),
+            Part(o.get("ours_one_thread"), 2),
+        ),
+    )
+
+
+def _odometry_peer(s: Sections) -> Cell | None:
+    o = s.get("odometry")
+    if not o or _get(o, "fastest") is None:
+        return None
+    parts = [
+        Part(_ratio(_get(o, "fastest", 1), o.get("ours")), 2, tg.PEER_RATIO, True),
+        Part(_get(o, "fastest", 1), 2),
+    ]
+    template = "{}× ({})"
+    if _get(o, "fastest_good") is not None and o["fastest_good"] != o["fastest"]:
+        parts.append(
+            Part(_ratio(_get(o, "fastest_good", 1), o.get("ours")), 2, tg.PEER_RATIO, True)
+        )
+        template += "; {}× at ≤ our error"
+    return Cell(template, tuple(parts))
+
+
+def _no_map(s: Sections) -> Cell | None:
+    o = s.get("odometry")
+    if not o or o.get("ours_poses_only") is None:
+        return None
+    bare = o["ours_poses_only"]
+    return Cell("{} ({}×)", (Part(bare, 2), Part(_ratio(_get(o, "fastest", 1), bare), 2)))
+
+
+def _growth(s: Sections, kind: str) -> float | None:
+    sub = _get(s, "sweeps", kind, 3)
+    if not sub:
+        return None
+    return _ratio(_get(sub, -1, "median"), _get(sub, 0, "median"))
+
+
+def _sweeps(s: Sections) -> Cell | None:
+    if not s.get("sweeps"):
+        return None
+    return Cell(
+        "{} / {} / {}",
+        (
+            Part(_get(s, "sweeps", "points", 3), 3, tg.LINEAR_R2, True),
+            Part(_growth(s, "map_padded"), 2, tg.FLAT_GROWTH),
+            Part(_growth(s, "map_recent"), 2, tg.FLAT_GROWTH),
+        ),
+    )
+
+
+def _threads(s: Sections) -> Cell | None:
+    t = s.get("threads")
+    if not t:
+        return None
+    return Cell(
+        "{}× ({}; {})",
+        (
+            Part(t.get("ratio"), 2, tg.THREADS_RATIO, True),
+            Part(t.get("control"), 2),
+            Part(t.get("bundle_ratio"), 2),
+        ),
+    )
+
+
+def _thread_ratio(key: str) -> Callable[[Sections], Cell | None]:
+    def cell(s: Sections) -> Cell | None:
+        v = _get(s, "threads", key)
+        return None if v is None else Cell("{}×", (Part(v, 2, tg.THREADS_RATIO, True),))
+
+    return cell
+
+
+def _placement(s: Sections) -> Cell | None:
+    t = s.get("threads")
+    if not t or t.get("cpu_read_runs") is None:
+        return None
+    keys = ("one_cpu_first_runs", "one_cpu_runs", "late_runs")
+    parts = (*(Part(t.get(k), 0) for k in keys), Part(len(t.get("late_s") or ()), 0))
+    return Cell("{} / {}; {} of {}", parts)
+
+
+def _memory(s: Sections) -> Cell | None:
+    per_cell = _get(s, "memory", "bytes_per_cell")
+    rss = _get(s, "odometry", "vmhwm_mib")
+    if per_cell is None and rss is None:
+        return None
+    return Cell("{} B/cell, {} MiB", (Part(per_cell, 0), Part(rss, 1)))
+
+
+ROWS = (
+    Row("match sim / URG / URG ≥ 500 [ms]", True, _match),
+    Row("≥ 3× fastest peer (SICK / URG pairs / URG map / sim map)", True, _peers),
+    Row("insert ≤ 50 µs", True, _insert),
+    Row("Intel ≤ 3 s (one thread)", True, _intel),
+    Row("≥ 3× fastest peer odometry (its s)", True, _odometry_peer),
+    Row("no map [s] (× fastest peer)", False, _no_map),
+    Row("linear (R²) / flat (padded / recent maps)", True, _sweeps),
+    Row("two threads ≥ 1.7×, started for each run (SHA-256; bundles)", True, _threads),
+    Row("two threads ≥ 1.7×, keep matching", True, _thread_ratio("steady_ratio")),
+    Row("two pinned workers ≥ 1.7×", True, _thread_ratio("pinned_ratio")),
+    Row("one `match_many` call ≥ 1.7×", True, _thread_ratio("many_ratio")),
+    Row(
+        "unpinned: on one vCPU at the first match / half-way; second thread ≥ 1 ms late (runs)",
+        False,
+        _placement,
+    ),
+    Row("memory", False, _memory),
+)
+
+
+@dataclass(frozen=True)
+class Run:
+    """One ``speed.py --json`` document: its column's name, machine and sections."""
+
+    name: str
+    machine: str
+    sections: Sections
+
+
+def read_run(path: Path, partial: bool = False) -> Run:
+    """The run in ``path``.
+
+    Raises
+    ------
+    ValueError
+        The file cannot be read, is not JSON, is not a ``speed.py --json`` document,
+        or holds a run that stopped part-way (unless ``partial``); the message names
+        the file.
+    """
+    try:
+        doc = json.loads(path.read_text())
+    except OSError as e:
+        raise ValueError(f"{path}: {e.strerror}") from e
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{path}: not JSON ({e.msg}, line {e.lineno})") from e
+    if not isinstance(doc, dict) or not isinstance(doc.get("sections"), dict):
+        raise ValueError(f'{path}: not a `speed.py --json` document (no "sections")')
+    if doc.get("complete") is not True and not partial:
+        raise ValueError(f"{path}: the run stopped part-way; --partial tables what it measured")
+    number = re.search(r"\d+", path.stem)
+    return Run(
+        number.group() if number else path.stem, str(doc.get("machine", "?")), doc["sections"]
+    )
+
+
+def _cells(run: Run) -> list[Cell | None]:
+    return [row.cell(run.sections) for row in ROWS]
+
+
+def met_every_target(cells: Sequence[Cell | None]) -> bool:
+    """Whether a run's cells meet every target row (a row not timed is no pass)."""
+    return all(c is not None and c.met() is True for c, r in zip(cells, ROWS) if r.target)
+
+
+def _count(cells: Sequence[Cell | None]) -> str:
+    judged = [v for v in (c.met() for c in cells if c is not None) if v is not None]
+    return f"{sum(judged)} of {len(judged)}" if judged else "–"
+
+
+def run_tables(runs: Sequence[Run], columns: int) -> list[str]:
+    """The per-run tables, ``columns`` runs at most in each."""
+    lines: list[str] = []
+    for start in range(0, len(runs), columns):
+        group = runs[start : start + columns]
+        cells = [_cells(r) for r in group]
+        if lines:
+            lines.append("")
+        lines.append("| target | " + " | ".join(r.name for r in group) + " | met |")
+        lines.append("|---|" + "---|" * (len(group) + 1))
+        for i, row in enumerate(ROWS):
+            col = [c[i] for c in cells]
+            shown = " | ".join("–" if c is None else c.text() for c in col)
+            lines.append(f"| {row.name} | {shown} | {_count(col) if row.target else '–'} |")
+    return lines
+
+
+def _span(parts: Sequence[Part]) -> str:
+    values = [p.value for p in parts if p.value is not None]
+    if not values:
+        return "–"
+    d = parts[0].digits
+    lo, hi = f"{min(values):.{d}f}", f"{max(values):.{d}f}"
+    return lo if lo == hi else f"{lo}–{hi}"
+
+
+def summary(runs: Sequence[Run]) -> list[str]:
+    """Each row's range and count over ``runs``, and the runs that met every target."""
+    cells = [_cells(r) for r in runs]
+    lines = [
+        f"| target | {len(runs)} runs | met |",
+        "|---|---|---|",
+    ]
+    for i, row in enumerate(ROWS):
+        col = [c[i] for c in cells]
+        shaped = [c for c in col if c is not None]
+        # Runs whose cell has another shape (another number of insert cases) are
+        # left out of the ranges, not of the count.
+        same = [c for c in shaped if c.template == shaped[0].template] if shaped else []
+        spans = (
+            shaped[0].template.format(
+                *(_span([c.parts[k] for c in same]) for k in range(len(same[0].parts)))
+            )
+            if same
+            else "–"
+        )
+        lines.append(f"| {row.name} | {spans} | {_count(col) if row.target else '–'} |")
+    every = [r.name for r, c in zip(runs, cells) if met_every_target(c)]
+    lines += [
+        "",
+        f"Every target met in {len(every)} of {len(runs)} runs"
+        + (f": {', '.join(every)}." if every else "."),
+    ]
+    return lines
+
+
+def machines(runs: Sequence[Run]) -> list[str]:
+    """Each machine (and commit) the runs name, with its runs."""
+    seen: dict[str, list[str]] = {}
+    for r in runs:
+        seen.setdefault(r.machine, []).append(r.name)
+    return [f"- {m}: runs {', '.join(names)}" for m, names in seen.items()]
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Print the tables of the runs named on the command line."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("runs", nargs="+", type=Path, help="speed.py --json files, in order")
+    ap.add_argument("--columns", type=int, default=8, help="runs per table (default 8)")
+    ap.add_argument("--partial", action="store_true", help="also runs that stopped part-way")
+    args = ap.parse_args(argv)
+    if args.columns < 1:
+        ap.error(f"--columns: expected an integer >= 1, got {args.columns}")
+    try:
+        runs = [read_run(p, args.partial) for p in args.runs]
+    except ValueError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    print("\n".join(["Machines:", *machines(runs), "", *run_tables(runs, args.columns)]))
+    print("\n" + "\n".join(summary(runs)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,210 @@
+"""`benches/speed_runs.py`: many `speed.py --json` runs as BENCHMARK.md's per-run tables,
+on documents written here in the shape `speed.py` writes."""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from tests._benches import load_bench
+
+sr = load_bench("speed_runs")
+TIMES = "\N{MULTIPLICATION SIGN}"
+DASH = "\N{EN DASH}"
+
+SECTIONS: dict[str, Any] = {
+    "match": {
+        "sick": {"ours": 1e-4, "fastest": ["small_gicp GICP", 1.5e-3]},
+        "urg_pairs": {"ours": 1e-4, "fastest": ["small_gicp GICP", 1.4e-3]},
+        "urg_map": {"ours": 6e-5, "fastest": ["small_gicp VGICP", 1.5e-3]},
+        "sim_map": {"ours": 8e-5, "fastest": ["small_gicp VGICP", 4.4e-3]},
+        "urg_log": {"≥ 500": [1.2e-4, 560]},
+    },
+    "insert": {
+        "sim URG-04LX 683 beams (true poses)": {"ours": 4.12e-5, "points": 548},
+        "real URG-04LX exp1 (poses from ndtgrid.Odometry)": {"ours": 3e-5, "points": 420},
+    },
+    "odometry": {
+        "scans": 13631,
+        "ours": 1.05,
+        "ours_one_thread": 1.9,
+        "ours_poses_only": 1.0,
+        "vmhwm_mib": 84.56,
+        "fastest": ["KISS-ICP (voxel 1.0 m)", 3.9],
+    },
+    "sweeps": {
+        "points": [0.0, 1e-7, 0.0, 0.9991],
+        "map_recent": [0, 0, 0, [{"median": 1.0, "cells": 10}, {"median": 0.64, "cells": 90}]],
+        "map_padded": [0, 0, 0, [{"median": 1.0, "cells": 10}, {"median": 0.97, "cells": 90}]],
+    },
+    "threads": {
+        "ratio": 1.76,
+        "control": 1.8,
+        "bundle_ratio": 1.85,
+        "steady_ratio": 1.9,
+        "pinned_ratio": 1.86,
+        "many_ratio": 1.88,
+        "one_cpu_first_runs": 11,
+        "one_cpu_runs": 1,
+        "cpu_read_runs": 21,
+        "late_runs": 4,
+        "late_s": [0.0005] * 21,
+    },
+    "memory": {"bytes_per_cell": 260.6},
+}
+
+
+def write(path: Path, sections: dict[str, Any], complete: bool = True) -> Path:
+    doc = {"machine": "2 cores of a test CPU, commit abc1234", "argv": [], "complete": complete}
+    path.write_text(json.dumps({**doc, "sections": sections}))
+    return path
+
+
+def row(lines: list[str], words: str) -> list[str]:
+    """The cells of the one table row whose name holds ``words`` (its name and the
+    met column included)."""
+    hits = [line for line in lines if line.startswith("| ") and words in line.split(" | ")[0]]
+    assert len(hits) == 1, hits
+    return [c.strip() for c in hits[0].strip("|").split("|")]
+
+
+def test_a_run_meeting_every_target(tmp_path: Path) -> None:
+    run = sr.read_run(write(tmp_path / "run539.json", SECTIONS))
+    assert run.name == "539"
+    lines = sr.run_tables([run], columns=8)
+    assert lines[0] == "| target | 539 | met |"
+    assert row(lines, "match sim / URG / URG ≥ 500 [ms]") == [
+        "match sim / URG / URG ≥ 500 [ms]",
+        "0.080 / 0.060 / 0.120",
+        "1 of 1",
+    ]
+    assert row(lines, "fastest peer (SICK")[1] == (f"15.00 / 14.00 / 25.00 / 55.00{TIMES}")
+    # Only the insert case of ≥ 500 points is judged, and shown.
+    assert row(lines, "insert ≤ 50 µs")[1:] == ["41.2", "1 of 1"]
+    assert row(lines, "Intel ≤ 3 s (one thread)")[1] == "1.05 (1.90)"
+    assert row(lines, "fastest peer odometry")[1] == f"3.71{TIMES} (3.90)"
+    assert row(lines, "no map")[1:] == [f"1.00 (3.90{TIMES})", DASH]
+    assert row(lines, "linear (R²) / flat (padded / recent maps)")[1] == "0.999 / 0.97 / 0.64"
+    assert row(lines, "started for each run")[1] == (f"1.76{TIMES} (1.80; 1.85)")
+    assert row(lines, "memory")[1] == "261 B/cell, 84.6 MiB"
+    assert sr.met_every_target([row.cell(run.sections) for row in sr.ROWS])
+
+
+def test_misses_are_bold_and_never_round_onto_the_limit(tmp_path: Path) -> None:
+    s = copy.deepcopy(SECTIONS)
+    s["threads"]["ratio"] = 1.6951
+    s["insert"]["sim URG-04LX 683 beams (true poses)"]["ours"] = 50.04e-6
+    s["match"]["urg_log"]["≥ 500"][0] = 2.013e-4
+    s["odometry"]["ours"] = 1.4  # the peer's 3.9 s over 1.4 s: 2.79 times
+    lines = sr.run_tables([sr.read_run(write(tmp_path / "r7.json", s))], columns=8)
+    assert row(lines, "started for each run")[1:] == [
+        f"**1.695**{TIMES} (1.80; 1.85)",
+        "0 of 1",
+    ]
+    assert row(lines, "insert ≤ 50 µs")[1:] == ["**50.04**", "0 of 1"]
+    assert row(lines, "match sim / URG / URG ≥ 500 [ms]")[1] == "0.080 / 0.060 / **0.201**"
+    assert row(lines, "fastest peer odometry")[1] == f"**2.79**{TIMES} (3.90)"
+    # A miss that does not round onto the limit keeps its digits.
+    s["threads"]["ratio"] = 1.52
+    lines = sr.run_tables([sr.read_run(write(tmp_path / "r8.json", s))], columns=8)
+    assert row(lines, "started for each run")[1] == (f"**1.52**{TIMES} (1.80; 1.85)")
+
+
+def test_a_section_not_run_is_a_dash_and_not_judged(tmp_path: Path) -> None:
+    s = {k: v for k, v in SECTIONS.items() if k != "threads"}
+    s["threads"] = {**SECTIONS["threads"], "pinned_ratio": None}  # one CPU: no pinned row
+    del s["threads"]["steady_ratio"]  # a run from before session 54
+    s["odometry"] = {**SECTIONS["odometry"], "scans": 921}  # --quick: not the whole log
+    run = sr.read_run(write(tmp_path / "run1.json", s))
+    lines = sr.run_tables([run], columns=8)
+    assert row(lines, "two pinned workers")[1:] == [DASH, DASH]
+    assert row(lines, "keep matching")[1:] == [DASH, DASH]
+    # Not the whole log: shown, not judged.
+    assert row(lines, "Intel ≤ 3 s (one thread)")[1:] == ["1.05 (1.90)", DASH]
+    assert not sr.met_every_target([r.cell(run.sections) for r in sr.ROWS])
+
+
+def test_tables_of_at_most_columns_runs_and_the_summary(tmp_path: Path) -> None:
+    slow = copy.deepcopy(SECTIONS)
+    slow["insert"]["sim URG-04LX 683 beams (true poses)"]["ours"] = 5.43e-5
+    slow["threads"]["ratio"] = 1.44
+    runs = [
+        sr.read_run(write(tmp_path / f"run{n}.json", slow if n == 11 else SECTIONS))
+        for n in (10, 11, 12)
+    ]
+    lines = sr.run_tables(runs, columns=2)
+    heads = [line for line in lines if line.startswith("| target |")]
+    assert heads == ["| target | 10 | 11 | met |", "| target | 12 | met |"]
+    assert lines[lines.index(heads[1]) - 1] == ""
+    assert [c for c in lines if c.startswith("| insert ≤ 50 µs |")] == [
+        "| insert ≤ 50 µs | 41.2 | **54.3** | 1 of 2 |",
+        "| insert ≤ 50 µs | 41.2 | 1 of 1 |",
+    ]
+    summary = sr.summary(runs)
+    assert summary[0] == "| target | 3 runs | met |"
+    assert row(summary, "insert ≤ 50 µs")[1:] == [f"41.2{DASH}54.3", "2 of 3"]
+    assert row(summary, "started for each run")[1:] == [
+        f"1.44{DASH}1.76{TIMES} (1.80; 1.85)",
+        "2 of 3",
+    ]
+    assert summary[-1] == "Every target met in 2 of 3 runs: 10, 12."
+
+
+def test_the_machines_and_their_runs(tmp_path: Path) -> None:
+    a = sr.read_run(write(tmp_path / "run1.json", SECTIONS))
+    b = sr.Run("2", "another machine", SECTIONS)
+    assert sr.machines([a, b, a]) == [
+        "- 2 cores of a test CPU, commit abc1234: runs 1, 1",
+        "- another machine: runs 2",
+    ]
+
+
+def test_unreadable_and_foreign_files_are_named(tmp_path: Path) -> None:
+    missing = tmp_path / "run9.json"
+    with pytest.raises(ValueError, match=rf"^{missing}: No such file or directory$"):
+        sr.read_run(missing)
+    bad = tmp_path / "bad.json"
+    bad.write_text("{\n  'x': 1\n}")
+    with pytest.raises(
+        ValueError,
+        match=rf"^{bad}: not JSON \(Expecting property name enclosed in double quotes, line 2\)$",
+    ):
+        sr.read_run(bad)
+    foreign = tmp_path / "estimates.json"
+    foreign.write_text('{"mean": {"point_estimate": 1.0}}')
+    with pytest.raises(
+        ValueError, match=rf'^{foreign}: not a `speed.py --json` document \(no "sections"\)$'
+    ):
+        sr.read_run(foreign)
+
+
+def test_a_run_stopped_part_way_only_with_partial(tmp_path: Path) -> None:
+    path = write(tmp_path / "run3.json", {"match": SECTIONS["match"]}, complete=False)
+    with pytest.raises(
+        ValueError, match=rf"^{path}: the run stopped part-way; --partial tables what it measured$"
+    ):
+        sr.read_run(path)
+    run = sr.read_run(path, partial=True)
+    lines = sr.run_tables([run], columns=8)
+    assert row(lines, "match sim / URG / URG ≥ 500 [ms]")[1:] == ["0.080 / 0.060 / 0.120", "1 of 1"]
+    assert row(lines, "insert ≤ 50 µs")[1:] == [DASH, DASH]
+    assert sr.summary([run])[-1] == "Every target met in 0 of 1 runs."
+
+
+def test_the_command_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    a, b = write(tmp_path / "run1.json", SECTIONS), write(tmp_path / "run2.json", SECTIONS)
+    assert sr.main([str(a), str(b), "--columns", "1"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("Machines:\n- 2 cores of a test CPU, commit abc1234: runs 1, 2\n\n")
+    assert out.count("| target | ") == 3  # two one-run tables and the summary
+    assert out.endswith("Every target met in 2 of 2 runs: 1, 2.\n")
+    assert sr.main([str(a), str(tmp_path / "run5.json")]) == 2
+    err = capsys.readouterr().err
+    assert err == f"error: {tmp_path / 'run5.json'}: No such file or directory\n"
+    with pytest.raises(SystemExit):
+        sr.main([str(a), "--columns", "0"])
+    assert "--columns: expected an integer >= 1, got 0" in capsys.readouterr().err
