@@ -1,7 +1,8 @@
 """Issue 7's speed targets: the one place their limits are written.
 
-``speed.py`` judges one run against them, ``speed_runs.py`` many runs' JSON, and
-``criterion_table.py`` the cases criterion times. Times are in seconds.
+``speed.py`` judges one run against them, ``speed_runs.py`` many runs' JSON and
+``criterion_table.py`` the cases criterion times; ``speed_plots.py`` draws the threads'
+line. Times are in seconds.
 """
 
 from __future__ import annotations
