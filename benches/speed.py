@@ -738,7 +738,7 @@ def section_insert(args: argparse.Namespace) -> dict[str, Any]:
         f"Our second row takes the same scans {BATCH} at a time through `insert_many` (the "
         "batch's first scan matched first, untimed), which brings the coarser levels and "
         "the distributions up to date once per batch: its time per scan, one sample per "
-        "batch; the issue's 50 µs target is judged on the first row. "
+        f"batch; the issue's {tg.INSERT_TEXT} target is judged on the first row. "
         "small_gicp's `GaussianVoxelMap.insert` needs the scan as a `PointCloud` with "
         "per-point covariances: its `preprocess_points` (3-layer lift, 1 cm merge, "
         "10 neighbours) is timed separately and added in the last columns. KISS-ICP's "
@@ -1935,15 +1935,15 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
         if key in m:
             v = m[key]["ours"]
             row(
-                f"median match ≤ 0.2 ms ({label} scan, {m[key]['points']:.0f} points median, "
-                "2 cm map of 20 scans)",
+                f"median match ≤ {tg.MATCH_TEXT} ({label} scan, {m[key]['points']:.0f} points "
+                "median, 2 cm map of 20 scans)",
                 f"{ms(v)} ms",
                 v <= tg.MATCH_S,
             )
     if "≥ 500" in m.get("urg_log", {}):
         v, npts = m["urg_log"]["≥ 500"]
         row(
-            f"median match ≤ 0.2 ms (real URG-04LX scans with ≥ 500 points, {npts:.0f} "
+            f"median match ≤ {tg.MATCH_TEXT} (real URG-04LX scans with ≥ 500 points, {npts:.0f} "
             "median, 2 cm map of 20 scans)",
             f"{ms(v)} ms",
             v <= tg.MATCH_S,
@@ -1963,11 +1963,15 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
                 value += f"; at ≥ our success: {gt / m[key]['ours']:.2f}× ({gname})"
             else:
                 value += "; no peer at ≥ our success"
-            row(f"≥ 3× faster than the fastest peer ({label})", value, r >= tg.PEER_RATIO)
+            row(
+                f"≥ {tg.PEER_TEXT} faster than the fastest peer ({label})",
+                value,
+                r >= tg.PEER_RATIO,
+            )
     ins = res.get("insert", {})
     for title, v in ins.items():
         row(
-            f"insert ≤ 50 µs ({title}, {v['points']:.0f} points)",
+            f"insert ≤ {tg.INSERT_TEXT} ({title}, {v['points']:.0f} points)",
             f"{us(v['ours'])} µs",
             v["ours"] <= tg.INSERT_S if v["points"] >= tg.INSERT_MIN_POINTS else None,
         )
@@ -1975,15 +1979,18 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
     if o:
         full = o["scans"] >= tg.INTEL_SCANS
         row(
-            f"Intel log through `Odometry` ≤ 3 s ({o['scans']} scans)",
+            f"Intel log through `Odometry` ≤ {tg.INTEL_TEXT} ({o['scans']} scans)",
             f"{o['ours']:.2f} s ({1e3 * o['ours'] / o['scans']:.3f} ms / scan), median of "
             f"{len(o['ours_runs'])} runs: {', '.join(f'{t:.2f}' for t in o['ours_runs'])} s; "
             f"one thread {o['ours_one_thread']:.2f} s; poses only {o['ours_poses_only']:.2f} s",
             o["ours"] <= tg.INTEL_S if full else None,
         )
         for key, label in (
-            ("fastest", "odometry ≥ 3× faster than the fastest peer"),
-            ("fastest_good", "odometry ≥ 3× faster than the fastest peer at ≤ our relation error"),
+            ("fastest", f"odometry ≥ {tg.PEER_TEXT} faster than the fastest peer"),
+            (
+                "fastest_good",
+                f"odometry ≥ {tg.PEER_TEXT} faster than the fastest peer at ≤ our relation error",
+            ),
         ):
             if key in o:
                 name, t = o[key]
@@ -1997,7 +2004,7 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
                 )
         if "fastest_good" not in o and "fastest" in o:
             row(
-                "odometry ≥ 3× faster than the fastest peer at ≤ our relation error",
+                f"odometry ≥ {tg.PEER_TEXT} faster than the fastest peer at ≤ our relation error",
                 "no peer reached our relation error",
                 None,
             )
@@ -2023,7 +2030,8 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
     t = res.get("threads", {})
     if t:
         row(
-            "two threads ≥ 1.7× one (threads started for each run, placed by the kernel)",
+            f"two threads ≥ {tg.THREADS_TEXT} one (threads started for each run, placed by the "
+            "kernel)",
             f"{t['ratio']:.2f}× (best runs {t['ratio_best']:.2f}×; GIL-free controls: "
             f"SHA-256 {t['control']:.2f}×, our matcher on {THREAD_BUNDLE}-scan bundles "
             f"{t['bundle_ratio']:.2f}×"
@@ -2040,7 +2048,7 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
         )
         pr = t.get("pinned_ratio", math.nan)
         row(
-            "two threads ≥ 1.7× one, the threads pinned to the two cores",
+            f"two threads ≥ {tg.THREADS_TEXT} one, the threads pinned to the two cores",
             "not measured"
             if math.isnan(pr)
             else f"{pr:.2f}× (best runs {t['pinned_ratio_best']:.2f}×)",
@@ -2048,7 +2056,7 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
         )
         sr = t.get("steady_ratio", math.nan)
         row(
-            "two threads ≥ 1.7× one, threads that keep matching "
+            f"two threads ≥ {tg.THREADS_TEXT} one, threads that keep matching "
             f"({t.get('steady_seconds', math.nan):g} s rounds, placed by the kernel)",
             "not measured"
             if math.isnan(sr)
@@ -2056,8 +2064,8 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
             None if math.isnan(sr) else sr >= tg.THREADS_RATIO,
         )
         row(
-            "one `match_many` call on every core ≥ 1.7× one thread (the library's own "
-            "threads, not Python's)",
+            f"one `match_many` call on every core ≥ {tg.THREADS_TEXT} one thread (the "
+            "library's own threads, not Python's)",
             f"{t['many_ratio']:.2f}× (best runs {t['many_ratio_best']:.2f}×)",
             t["many_ratio"] >= tg.THREADS_RATIO,
         )

@@ -110,7 +110,7 @@ def plot_threads(
         ys = runs.get(key, [])
         if ys:
             a.plot(np.arange(1, len(ys) + 1), ys, marker, label=label, alpha=0.85, **style)
-    a.axhline(tg.THREADS_RATIO, color="k", lw=0.8, ls="--", label=f"target {tg.THREADS_RATIO:g}×")
+    a.axhline(tg.THREADS_RATIO, color="k", lw=0.8, ls="--", label=f"target {tg.THREADS_TEXT}")
     a.axhline(2.0, color="0.6", lw=0.8)
     a.set_xlabel("run (one- and two-thread runs alternate)")
     a.set_ylabel("one thread's time / two threads' time")

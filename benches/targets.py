@@ -25,3 +25,10 @@ LINEAR_R2 = 0.95
 FLAT_GROWTH = 1.2
 # Two threads matching different scans: at least this many times one thread's throughput.
 THREADS_RATIO = 1.7
+
+# The limits as the tables and labels write them (one source with the numbers above).
+MATCH_TEXT = f"{MATCH_S * 1e3:g} ms"
+INSERT_TEXT = f"{INSERT_S * 1e6:g} µs"
+PEER_TEXT = f"{PEER_RATIO:g}×"
+INTEL_TEXT = f"{INTEL_S:g} s"
+THREADS_TEXT = f"{THREADS_RATIO:g}×"
