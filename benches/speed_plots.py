@@ -1,5 +1,6 @@
 """Pictures of ``benches/speed.py``: the match-time sweeps, the thread runs, and this
-library against its peers (match, map update, odometry) in one run.
+library against its peers (match, map update, odometry) in one run; and, for
+``benches/speed_runs.py``, each target's numbers over many runs.
 
 matplotlib is imported lazily; without it each ``plot_*`` returns ``None`` and draws
 nothing (``speed.py`` says so in its output).
@@ -10,6 +11,7 @@ from __future__ import annotations
 import math
 import re
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -329,3 +331,68 @@ def plot_peers(res: dict[str, dict[str, Any]], path: Path, machine: str) -> Path
         f"named\n{machine}",
         path,
     )
+
+
+@dataclass(frozen=True)
+class RunSeries:
+    """One judged number over many runs: its legend's label and its value in each run
+    (``None`` where the run did not measure it)."""
+
+    label: str
+    values: tuple[float | None, ...]
+
+    def met(self, limit: float, at_least: bool) -> tuple[bool | None, ...]:
+        """Whether each value meets ``limit`` (reaches it when ``at_least``, else does
+        not exceed it); ``None`` where the run did not measure it."""
+        return tuple(
+            None if v is None else (v >= limit if at_least else v <= limit) for v in self.values
+        )
+
+    def legend(self, limit: float, at_least: bool) -> str:
+        """The label with the count of runs that met ``limit``, of those measured."""
+        met = self.met(limit, at_least)
+        judged = [m for m in met if m is not None]
+        return f"{self.label} ({sum(judged)} of {len(judged)})"
+
+
+@dataclass(frozen=True)
+class TargetPanel:
+    """One target's picture over many runs: its title, its limit (which a value must
+    reach when ``at_least``, else not exceed) and its numbers."""
+
+    title: str
+    limit: float
+    at_least: bool
+    series: tuple[RunSeries, ...]
+
+
+def plot_runs(
+    names: Sequence[str], panels: Sequence[TargetPanel], title: str, path: Path
+) -> Path | None:
+    """Each target's numbers run by run as a PNG, a panel per target: the limit dashed,
+    each miss ringed in red, each series' count of runs that met the limit in its
+    label. ``names`` are the runs' names, in order. Its path, or ``None`` without
+    matplotlib."""
+    plt = pyplot()
+    if plt is None:
+        return None
+    cols = 2
+    rows = max(1, math.ceil(len(panels) / cols))
+    fig, axes = plt.subplots(rows, cols, figsize=(12, 3.3 * rows + 0.6), squeeze=False)
+    x = np.arange(len(names))
+    step = max(1, math.ceil(len(names) / 12))
+    for ax, panel in zip(axes.flat, panels):
+        for s in panel.series:
+            v = np.array([np.nan if y is None else y for y in s.values], dtype=float)
+            miss = np.array([m is False for m in s.met(panel.limit, panel.at_least)], dtype=bool)
+            ax.plot(x, v, "o-", ms=3.5, lw=0.8, label=s.legend(panel.limit, panel.at_least))
+            ax.plot(x[miss], v[miss], "o", ms=9, mfc="none", mec="red", mew=1.3)
+        ax.axhline(panel.limit, color="k", lw=0.8, ls="--")
+        ax.set_title(panel.title, fontsize=9)
+        ax.set_xticks(x[::step], [names[i] for i in range(0, len(names), step)], fontsize=7)
+        ax.tick_params(axis="y", labelsize=7)
+        ax.set_xlabel("run", fontsize=8)
+        ax.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.2))
+    for ax in axes.flat[len(panels) :]:
+        ax.set_visible(False)
+    return save_figure(fig, title, path)

@@ -8,11 +8,12 @@ that misses its target is in bold, with one more digit when it rounds onto the l
 (a ratio of 1.695 is no 1.70). Tables of at most ``--columns`` runs; then, over all the runs,
 each row's range and count, and the runs that met every target. A section a run did
 not time reads as a dash and is not judged; such a run did not meet every target.
+``--plot PATH`` also draws each target's numbers run by run (needs matplotlib).
 
 Run from the repository root, e.g.::
 
     python benches/speed.py --json /tmp/run1.json   # as many times as wanted
-    python benches/speed_runs.py /tmp/run*.json
+    python benches/speed_runs.py /tmp/run*.json --plot /tmp/runs.png
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import speed_plots
 import targets as tg
 
 Sections = dict[str, Any]
@@ -37,12 +39,15 @@ Sections = dict[str, Any]
 class Part:
     """One number of a cell: ``value`` printed with ``digits`` decimals (``None``: not
     measured), judged against ``limit`` (``None``: not judged), which it must reach
-    (``at_least``) or not exceed."""
+    (``at_least``) or not exceed; a judged number is drawn as the series ``label`` in
+    the picture ``panel``."""
 
     value: float | None
     digits: int
     limit: float | None = None
     at_least: bool = False
+    label: str = ""
+    panel: str = ""
 
     def met(self) -> bool | None:
         """Whether the number meets its limit; ``None`` where either is missing."""
@@ -117,31 +122,59 @@ def _match(s: Sections) -> Cell | None:
         return None
     limit = tg.MATCH_S * 1e3
     times = (
-        _get(m, "sim_map", "ours"),
-        _get(m, "urg_map", "ours"),
-        _get(m, "urg_log", "≥ 500", 0),
+        (_get(m, "sim_map", "ours"), "simulated URG-04LX"),
+        (_get(m, "urg_map", "ours"), "real URG-04LX"),
+        (_get(m, "urg_log", "≥ 500", 0), "real URG-04LX, ≥ 500 points"),
     )
-    return Cell("{} / {} / {}", tuple(Part(_scaled(t, 1e3), 3, limit) for t in times))
+    panel = f"median match ≤ {tg.MATCH_TEXT} [ms]"
+    return Cell(
+        "{} / {} / {}",
+        tuple(Part(_scaled(t, 1e3), 3, limit, label=k, panel=panel) for t, k in times),
+    )
 
 
-PEER_CASES = ("sick", "urg_pairs", "urg_map", "sim_map")
+PEER_CASES = {
+    "sick": "real SICK pairs",
+    "urg_pairs": "real URG pairs",
+    "urg_map": "real URG map",
+    "sim_map": "simulated map",
+}
 
 
 def _peers(s: Sections) -> Cell | None:
     m = s.get("match")
     if not m:
         return None
-    ratios = (_ratio(_get(m, k, "fastest", 1), _get(m, k, "ours")) for k in PEER_CASES)
-    return Cell("{} / {} / {} / {}×", tuple(Part(r, 2, tg.PEER_RATIO, True) for r in ratios))
+    panel = f"match: the fastest peer's time / ours ≥ {tg.PEER_TEXT}"
+    return Cell(
+        "{} / {} / {} / {}×",
+        tuple(
+            Part(
+                _ratio(_get(m, k, "fastest", 1), _get(m, k, "ours")),
+                2,
+                tg.PEER_RATIO,
+                True,
+                label,
+                panel,
+            )
+            for k, label in PEER_CASES.items()
+        ),
+    )
 
 
 def _insert(s: Sections) -> Cell | None:
-    judged = [
-        v for v in (s.get("insert") or {}).values() if v.get("points", 0) >= tg.INSERT_MIN_POINTS
-    ]
+    judged = {
+        k: v
+        for k, v in (s.get("insert") or {}).items()
+        if v.get("points", 0) >= tg.INSERT_MIN_POINTS
+    }
     if not judged:
         return None
-    parts = tuple(Part(_scaled(v.get("ours"), 1e6), 1, tg.INSERT_S * 1e6) for v in judged)
+    panel = f"insert of a scan of ≥ {tg.INSERT_MIN_POINTS} points ≤ {tg.INSERT_TEXT} [µs]"
+    parts = tuple(
+        Part(_scaled(v.get("ours"), 1e6), 1, tg.INSERT_S * 1e6, label=k, panel=panel)
+        for k, v in judged.items()
+    )
     return Cell(" / ".join("{}" for _ in parts), parts)
 
 
@@ -153,7 +186,13 @@ def _intel(s: Sections) -> Cell | None:
     return Cell(
         "{} ({})",
         (
-            Part(o.get("ours"), 2, tg.INTEL_S if full else None),
+            Part(
+                o.get("ours"),
+                2,
+                tg.INTEL_S if full else None,
+                label="ndtgrid.Odometry",
+                panel=f"the Intel log ({tg.INTEL_SCANS} scans) ≤ {tg.INTEL_TEXT} [s]",
+            ),
             Part(o.get("ours_one_thread"), 2),
         ),
     )
@@ -163,14 +202,29 @@ def _odometry_peer(s: Sections) -> Cell | None:
     o = s.get("odometry")
     if not o or _get(o, "fastest") is None:
         return None
+    panel = f"odometry: the fastest peer's time / ours ≥ {tg.PEER_TEXT}"
     parts = [
-        Part(_ratio(_get(o, "fastest", 1), o.get("ours")), 2, tg.PEER_RATIO, True),
+        Part(
+            _ratio(_get(o, "fastest", 1), o.get("ours")),
+            2,
+            tg.PEER_RATIO,
+            True,
+            "the fastest peer",
+            panel,
+        ),
         Part(_get(o, "fastest", 1), 2),
     ]
     template = "{}× ({})"
     if _get(o, "fastest_good") is not None and o["fastest_good"] != o["fastest"]:
         parts.append(
-            Part(_ratio(_get(o, "fastest_good", 1), o.get("ours")), 2, tg.PEER_RATIO, True)
+            Part(
+                _ratio(_get(o, "fastest_good", 1), o.get("ours")),
+                2,
+                tg.PEER_RATIO,
+                True,
+                "the fastest peer at ≤ our error",
+                panel,
+            )
         )
         template += "; {}× at ≤ our error"
     return Cell(template, tuple(parts))
@@ -194,14 +248,25 @@ def _growth(s: Sections, kind: str) -> float | None:
 def _sweeps(s: Sections) -> Cell | None:
     if not s.get("sweeps"):
         return None
+    flat = f"match time, largest map / smallest ≤ {tg.FLAT_GROWTH:g}"
     return Cell(
         "{} / {} / {}",
         (
-            Part(_get(s, "sweeps", "points", 3), 3, tg.LINEAR_R2, True),
-            Part(_growth(s, "map_padded"), 2, tg.FLAT_GROWTH),
-            Part(_growth(s, "map_recent"), 2, tg.FLAT_GROWTH),
+            Part(
+                _get(s, "sweeps", "points", 3),
+                3,
+                tg.LINEAR_R2,
+                True,
+                "R² of a line through time against points",
+                f"match time linear in scan points: R² ≥ {tg.LINEAR_R2:g}",
+            ),
+            Part(_growth(s, "map_padded"), 2, tg.FLAT_GROWTH, label="padded maps", panel=flat),
+            Part(_growth(s, "map_recent"), 2, tg.FLAT_GROWTH, label="recent maps", panel=flat),
         ),
     )
+
+
+THREADS_PANEL = f"two threads' throughput / one thread's ≥ {tg.THREADS_TEXT}"
 
 
 def _threads(s: Sections) -> Cell | None:
@@ -211,17 +276,19 @@ def _threads(s: Sections) -> Cell | None:
     return Cell(
         "{}× ({}; {})",
         (
-            Part(t.get("ratio"), 2, tg.THREADS_RATIO, True),
+            Part(t.get("ratio"), 2, tg.THREADS_RATIO, True, "started for each run", THREADS_PANEL),
             Part(t.get("control"), 2),
             Part(t.get("bundle_ratio"), 2),
         ),
     )
 
 
-def _thread_ratio(key: str) -> Callable[[Sections], Cell | None]:
+def _thread_ratio(key: str, label: str) -> Callable[[Sections], Cell | None]:
     def cell(s: Sections) -> Cell | None:
         v = _get(s, "threads", key)
-        return None if v is None else Cell("{}×", (Part(v, 2, tg.THREADS_RATIO, True),))
+        if v is None:
+            return None
+        return Cell("{}×", (Part(v, 2, tg.THREADS_RATIO, True, label, THREADS_PANEL),))
 
     return cell
 
@@ -254,9 +321,21 @@ ROWS = (
     Row(
         f"two threads ≥ {tg.THREADS_TEXT}, started for each run (SHA-256; bundles)", True, _threads
     ),
-    Row(f"two threads ≥ {tg.THREADS_TEXT}, keep matching", True, _thread_ratio("steady_ratio")),
-    Row(f"two pinned workers ≥ {tg.THREADS_TEXT}", True, _thread_ratio("pinned_ratio")),
-    Row(f"one `match_many` call ≥ {tg.THREADS_TEXT}", True, _thread_ratio("many_ratio")),
+    Row(
+        f"two threads ≥ {tg.THREADS_TEXT}, keep matching",
+        True,
+        _thread_ratio("steady_ratio", "keep matching"),
+    ),
+    Row(
+        f"two pinned workers ≥ {tg.THREADS_TEXT}",
+        True,
+        _thread_ratio("pinned_ratio", "pinned workers"),
+    ),
+    Row(
+        f"one `match_many` call ≥ {tg.THREADS_TEXT}",
+        True,
+        _thread_ratio("many_ratio", "one match_many call"),
+    ),
     Row(
         "unpinned: on one vCPU at the first match / half-way; second thread ≥ 1 ms late (runs)",
         False,
@@ -371,6 +450,30 @@ def summary(runs: Sequence[Run]) -> list[str]:
     return lines
 
 
+def target_panels(runs: Sequence[Run]) -> list[speed_plots.TargetPanel]:
+    """The judged numbers of ``runs`` as pictures: a panel per ``Part.panel``, a series
+    per label, a value per run; panels and series in the order of the rows and their
+    parts."""
+    found: dict[str, tuple[float, bool, dict[str, list[float | None]]]] = {}
+    cells = [_cells(run) for run in runs]
+    for j, row in enumerate(ROWS):
+        for i in range(len(runs)):
+            cell = cells[i][j]
+            if not row.target or cell is None:
+                continue
+            for p in cell.parts:
+                if p.limit is None or not p.panel:
+                    continue
+                series = found.setdefault(p.panel, (p.limit, p.at_least, {}))[2]
+                series.setdefault(p.label, [None] * len(runs))[i] = p.value
+    return [
+        speed_plots.TargetPanel(
+            title, limit, at_least, tuple(speed_plots.RunSeries(k, tuple(v)) for k, v in s.items())
+        )
+        for title, (limit, at_least, s) in found.items()
+    ]
+
+
 def machines(runs: Sequence[Run]) -> list[str]:
     """Each machine (and commit) the runs name, with its runs."""
     seen: dict[str, list[str]] = {}
@@ -385,9 +488,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("runs", nargs="+", type=Path, help="speed.py --json files, in order")
     ap.add_argument("--columns", type=int, default=8, help="runs per table (default 8)")
     ap.add_argument("--partial", action="store_true", help="also runs that stopped part-way")
+    ap.add_argument(
+        "--plot", type=Path, metavar="PATH", help="also draw each target run by run (a PNG)"
+    )
     args = ap.parse_args(argv)
     if args.columns < 1:
         ap.error(f"--columns: expected an integer >= 1, got {args.columns}")
+    if args.plot is not None and speed_plots.pyplot() is None:
+        ap.error("--plot needs matplotlib (pip install matplotlib)")
     try:
         runs = [read_run(p, args.partial) for p in args.runs]
     except ValueError as e:
@@ -395,6 +503,19 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     print("\n".join(["Machines:", *machines(runs), "", *run_tables(runs, args.columns)]))
     print("\n" + "\n".join(summary(runs)))
+    if args.plot is not None:
+        title = (
+            f"Issue 7's targets in {len(runs)} runs of benches/speed.py "
+            "(dashed: the limit; ringed: a miss)"
+        )
+        try:
+            drawn = speed_plots.plot_runs(
+                [r.name for r in runs], target_panels(runs), title, args.plot
+            )
+        except OSError as e:
+            print(f"error: {args.plot}: {e.strerror}", file=sys.stderr)
+            return 2
+        print(f"\nPicture: {drawn}")
     return 0
 
 

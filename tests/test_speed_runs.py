@@ -208,3 +208,80 @@ def test_the_command_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
     with pytest.raises(SystemExit):
         sr.main([str(a), "--columns", "0"])
     assert "--columns: expected an integer >= 1, got 0" in capsys.readouterr().err
+
+
+def test_the_judged_numbers_run_by_run(tmp_path: Path) -> None:
+    slow = copy.deepcopy(SECTIONS)
+    slow["insert"]["sim URG-04LX 683 beams (true poses)"]["ours"] = 5.43e-5
+    slow["threads"]["ratio"] = 1.44
+    short = {k: v for k, v in SECTIONS.items() if k != "sweeps"}
+    short["odometry"] = {**SECTIONS["odometry"], "scans": 921}  # not the whole log
+    runs = [
+        sr.read_run(write(tmp_path / f"run{n}.json", s))
+        for n, s in ((1, SECTIONS), (2, slow), (3, short))
+    ]
+    panels = sr.target_panels(runs)
+    assert [p.title for p in panels] == [
+        "median match ≤ 0.2 ms [ms]",
+        f"match: the fastest peer's time / ours ≥ 3{TIMES}",
+        "insert of a scan of ≥ 500 points ≤ 50 µs [µs]",
+        "the Intel log (13631 scans) ≤ 3 s [s]",
+        f"odometry: the fastest peer's time / ours ≥ 3{TIMES}",
+        "match time linear in scan points: R² ≥ 0.95",
+        "match time, largest map / smallest ≤ 1.2",
+        f"two threads' throughput / one thread's ≥ 1.7{TIMES}",
+    ]
+    match, peers, insert, intel, _, linear, flat, threads = panels
+    assert [s.label for s in match.series] == [
+        "simulated URG-04LX",
+        "real URG-04LX",
+        "real URG-04LX, ≥ 500 points",
+    ]
+    assert match.series[0].values == pytest.approx((0.08, 0.08, 0.08))
+    assert [s.label for s in peers.series] == [
+        "real SICK pairs",
+        "real URG pairs",
+        "real URG map",
+        "simulated map",
+    ]
+    assert peers.series[0].values == pytest.approx((15.0, 15.0, 15.0))
+    # Only the case of ≥ 500 points, in µs; its miss is counted out of the legend.
+    assert (insert.limit, insert.at_least) == (50.0, False)
+    [case] = insert.series
+    assert case.label == "sim URG-04LX 683 beams (true poses)"
+    assert case.values == pytest.approx((41.2, 54.3, 41.2))
+    assert case.met(insert.limit, insert.at_least) == (True, False, True)
+    assert case.legend(insert.limit, insert.at_least) == f"{case.label} (2 of 3)"
+    # A short log is not judged: no value drawn.
+    assert intel.series[0].values == (1.05, 1.05, None)
+    assert intel.series[0].legend(intel.limit, intel.at_least) == "ndtgrid.Odometry (2 of 2)"
+    assert (linear.limit, linear.at_least) == (0.95, True)
+    assert linear.series[0].values == (0.9991, 0.9991, None)
+    assert [s.label for s in flat.series] == ["padded maps", "recent maps"]
+    assert [s.label for s in threads.series] == [
+        "started for each run",
+        "keep matching",
+        "pinned workers",
+        "one match_many call",
+    ]
+    started = threads.series[0]
+    assert started.values == (1.76, 1.44, 1.76)
+    assert started.legend(threads.limit, threads.at_least) == "started for each run (2 of 3)"
+
+
+def test_the_picture_on_the_command_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    a = write(tmp_path / "run1.json", SECTIONS)
+    png = tmp_path / "pictures" / "runs.png"
+    assert sr.main([str(a), "--plot", str(png)]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert capsys.readouterr().out.endswith(f"\nPicture: {png.resolve()}\n")
+    blocked = tmp_path / "a file"
+    blocked.write_text("")
+    assert sr.main([str(a), "--plot", str(blocked / "runs.png")]) == 2
+    assert capsys.readouterr().err == f"error: {blocked / 'runs.png'}: File exists\n"
+    monkeypatch.setattr(sr.speed_plots, "pyplot", lambda: None)
+    with pytest.raises(SystemExit):
+        sr.main([str(a), "--plot", str(png)])
+    assert "--plot needs matplotlib (pip install matplotlib)" in capsys.readouterr().err
