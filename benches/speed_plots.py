@@ -335,34 +335,26 @@ def plot_peers(res: dict[str, dict[str, Any]], path: Path, machine: str) -> Path
 
 @dataclass(frozen=True)
 class RunSeries:
-    """One judged number over many runs: its legend's label and its value in each run
-    (``None`` where the run did not measure it)."""
+    """One judged number over many runs: its legend's label, its value in each run and
+    whether the value met its limit (both ``None`` where the run did not measure or
+    judge it)."""
 
     label: str
     values: tuple[float | None, ...]
+    met: tuple[bool | None, ...]
 
-    def met(self, limit: float, at_least: bool) -> tuple[bool | None, ...]:
-        """Whether each value meets ``limit`` (reaches it when ``at_least``, else does
-        not exceed it); ``None`` where the run did not measure it."""
-        return tuple(
-            None if v is None else (v >= limit if at_least else v <= limit) for v in self.values
-        )
-
-    def legend(self, limit: float, at_least: bool) -> str:
-        """The label with the count of runs that met ``limit``, of those measured."""
-        met = self.met(limit, at_least)
-        judged = [m for m in met if m is not None]
+    def legend(self) -> str:
+        """The label with the count of runs that met the limit, of those judged."""
+        judged = [m for m in self.met if m is not None]
         return f"{self.label} ({sum(judged)} of {len(judged)})"
 
 
 @dataclass(frozen=True)
 class TargetPanel:
-    """One target's picture over many runs: its title, its limit (which a value must
-    reach when ``at_least``, else not exceed) and its numbers."""
+    """One target's picture over many runs: its title, its limit and its numbers."""
 
     title: str
     limit: float
-    at_least: bool
     series: tuple[RunSeries, ...]
 
 
@@ -384,8 +376,8 @@ def plot_runs(
     for ax, panel in zip(axes.flat, panels):
         for s in panel.series:
             v = np.array([np.nan if y is None else y for y in s.values], dtype=float)
-            miss = np.array([m is False for m in s.met(panel.limit, panel.at_least)], dtype=bool)
-            ax.plot(x, v, "o-", ms=3.5, lw=0.8, label=s.legend(panel.limit, panel.at_least))
+            miss = np.array([m is False for m in s.met], dtype=bool)
+            ax.plot(x, v, "o-", ms=3.5, lw=0.8, label=s.legend())
             ax.plot(x[miss], v[miss], "o", ms=9, mfc="none", mec="red", mew=1.3)
         ax.axhline(panel.limit, color="k", lw=0.8, ls="--")
         ax.set_title(panel.title, fontsize=9)

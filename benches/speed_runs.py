@@ -452,9 +452,9 @@ def summary(runs: Sequence[Run]) -> list[str]:
 
 def target_panels(runs: Sequence[Run]) -> list[speed_plots.TargetPanel]:
     """The judged numbers of ``runs`` as pictures: a panel per ``Part.panel``, a series
-    per label, a value per run; panels and series in the order of the rows and their
-    parts."""
-    found: dict[str, tuple[float, bool, dict[str, list[float | None]]]] = {}
+    per label, a value and its verdict (``Part.met``) per run; panels and series in the
+    order of the rows and their parts."""
+    found: dict[str, tuple[float, dict[str, list[Part | None]]]] = {}
     cells = [_cells(run) for run in runs]
     for j, row in enumerate(ROWS):
         for i in range(len(runs)):
@@ -464,13 +464,22 @@ def target_panels(runs: Sequence[Run]) -> list[speed_plots.TargetPanel]:
             for p in cell.parts:
                 if p.limit is None or not p.panel:
                     continue
-                series = found.setdefault(p.panel, (p.limit, p.at_least, {}))[2]
-                series.setdefault(p.label, [None] * len(runs))[i] = p.value
+                series = found.setdefault(p.panel, (p.limit, {}))[1]
+                series.setdefault(p.label, [None] * len(runs))[i] = p
     return [
         speed_plots.TargetPanel(
-            title, limit, at_least, tuple(speed_plots.RunSeries(k, tuple(v)) for k, v in s.items())
+            title,
+            limit,
+            tuple(
+                speed_plots.RunSeries(
+                    label,
+                    tuple(None if p is None else p.value for p in parts),
+                    tuple(None if p is None else p.met() for p in parts),
+                )
+                for label, parts in s.items()
+            ),
         )
-        for title, (limit, at_least, s) in found.items()
+        for title, (limit, s) in found.items()
     ]
 
 

@@ -246,17 +246,23 @@ def test_the_judged_numbers_run_by_run(tmp_path: Path) -> None:
     ]
     assert peers.series[0].values == pytest.approx((15.0, 15.0, 15.0))
     # Only the case of ≥ 500 points, in µs; its miss is counted out of the legend.
-    assert (insert.limit, insert.at_least) == (50.0, False)
+    assert insert.limit == 50.0
     [case] = insert.series
     assert case.label == "sim URG-04LX 683 beams (true poses)"
     assert case.values == pytest.approx((41.2, 54.3, 41.2))
-    assert case.met(insert.limit, insert.at_least) == (True, False, True)
-    assert case.legend(insert.limit, insert.at_least) == f"{case.label} (2 of 3)"
+    assert case.met == (True, False, True)
+    assert case.legend() == f"{case.label} (2 of 3)"
     # A short log is not judged: no value drawn.
     assert intel.series[0].values == (1.05, 1.05, None)
-    assert intel.series[0].legend(intel.limit, intel.at_least) == "ndtgrid.Odometry (2 of 2)"
-    assert (linear.limit, linear.at_least) == (0.95, True)
+    assert intel.series[0].met == (True, True, None)
+    assert intel.series[0].legend() == "ndtgrid.Odometry (2 of 2)"
+    # R² must reach its limit, the growths not exceed theirs.
+    assert linear.limit == 0.95
     assert linear.series[0].values == (0.9991, 0.9991, None)
+    assert linear.series[0].met == (True, True, None)
+    assert flat.limit == 1.2
+    assert flat.series[1].values == pytest.approx((0.64, 0.64, None))
+    assert flat.series[1].met == (True, True, None)
     assert [s.label for s in flat.series] == ["padded maps", "recent maps"]
     assert [s.label for s in threads.series] == [
         "started for each run",
@@ -266,7 +272,8 @@ def test_the_judged_numbers_run_by_run(tmp_path: Path) -> None:
     ]
     started = threads.series[0]
     assert started.values == (1.76, 1.44, 1.76)
-    assert started.legend(threads.limit, threads.at_least) == "started for each run (2 of 3)"
+    assert started.met == (True, False, True)
+    assert started.legend() == "started for each run (2 of 3)"
 
 
 def test_the_picture_on_the_command_line(
