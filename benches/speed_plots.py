@@ -381,7 +381,7 @@ def plot_runs(
             ax.plot(x[miss], v[miss], "o", ms=9, mfc="none", mec="red", mew=1.3)
         ax.axhline(panel.limit, color="k", lw=0.8, ls="--")
         ax.set_title(panel.title, fontsize=9)
-        ax.set_xticks(x[::step], [names[i] for i in range(0, len(names), step)], fontsize=7)
+        ax.set_xticks(x[::step], list(names[::step]), fontsize=7)
         ax.tick_params(axis="y", labelsize=7)
         ax.set_xlabel("run", fontsize=8)
         ax.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.2))

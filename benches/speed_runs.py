@@ -24,6 +24,7 @@ import re
 import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -353,6 +354,12 @@ class Run:
     machine: str
     sections: Sections
 
+    @cached_property
+    def cells(self) -> tuple[Cell | None, ...]:
+        """Its cell in each of ``ROWS``, worked out once for the tables, the summary and
+        the picture (``None`` where the run did not time the row)."""
+        return tuple(row.cell(self.sections) for row in ROWS)
+
 
 def read_run(path: Path, partial: bool = False) -> Run:
     """The run in ``path``.
@@ -380,10 +387,6 @@ def read_run(path: Path, partial: bool = False) -> Run:
     )
 
 
-def _cells(run: Run) -> list[Cell | None]:
-    return [row.cell(run.sections) for row in ROWS]
-
-
 def met_every_target(cells: Sequence[Cell | None]) -> bool:
     """Whether a run's cells meet every target row (a row not timed is no pass)."""
     return all(c is not None and c.met() is True for c, r in zip(cells, ROWS) if r.target)
@@ -399,7 +402,7 @@ def run_tables(runs: Sequence[Run], columns: int) -> list[str]:
     lines: list[str] = []
     for start in range(0, len(runs), columns):
         group = runs[start : start + columns]
-        cells = [_cells(r) for r in group]
+        cells = [r.cells for r in group]
         if lines:
             lines.append("")
         lines.append("| target | " + " | ".join(r.name for r in group) + " | met |")
@@ -422,7 +425,7 @@ def _span(parts: Sequence[Part]) -> str:
 
 def summary(runs: Sequence[Run]) -> list[str]:
     """Each row's range and count over ``runs``, and the runs that met every target."""
-    cells = [_cells(r) for r in runs]
+    cells = [r.cells for r in runs]
     lines = [
         f"| target | {len(runs)} runs | met |",
         "|---|---|---|",
@@ -455,7 +458,7 @@ def target_panels(runs: Sequence[Run]) -> list[speed_plots.TargetPanel]:
     per label, a value and its verdict (``Part.met``) per run; panels and series in the
     order of the rows and their parts."""
     found: dict[str, tuple[float, dict[str, list[Part | None]]]] = {}
-    cells = [_cells(run) for run in runs]
+    cells = [run.cells for run in runs]
     for j, row in enumerate(ROWS):
         for i in range(len(runs)):
             cell = cells[i][j]
