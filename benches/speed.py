@@ -1973,11 +1973,11 @@ def targets(res: dict[str, dict[str, Any]]) -> None:
         row(
             f"insert ≤ {tg.INSERT_TEXT} ({title}, {v['points']:.0f} points)",
             f"{us(v['ours'])} µs",
-            v["ours"] <= tg.INSERT_S if v["points"] >= tg.INSERT_MIN_POINTS else None,
+            v["ours"] <= tg.INSERT_S if tg.insert_judged(v["points"]) else None,
         )
     o = res.get("odometry", {})
     if o:
-        full = o["scans"] >= tg.INTEL_SCANS
+        full = tg.intel_judged(o["scans"])
         row(
             f"Intel log through `Odometry` ≤ {tg.INTEL_TEXT} ({o['scans']} scans)",
             f"{o['ours']:.2f} s ({1e3 * o['ours'] / o['scans']:.3f} ms / scan), median of "

@@ -165,9 +165,7 @@ def _peers(s: Sections) -> Cell | None:
 
 def _insert(s: Sections) -> Cell | None:
     judged = {
-        k: v
-        for k, v in (s.get("insert") or {}).items()
-        if v.get("points", 0) >= tg.INSERT_MIN_POINTS
+        k: v for k, v in (s.get("insert") or {}).items() if tg.insert_judged(v.get("points", 0))
     }
     if not judged:
         return None
@@ -183,7 +181,7 @@ def _intel(s: Sections) -> Cell | None:
     o = s.get("odometry")
     if not o:
         return None
-    full = o.get("scans", 0) >= tg.INTEL_SCANS
+    full = tg.intel_judged(o.get("scans", 0))
     return Cell(
         "{} ({})",
         (

@@ -1,4 +1,5 @@
-"""Issue 7's speed targets: the one place their limits are written.
+"""Issue 7's speed targets: the one place their limits, and which cases they judge, are
+written.
 
 ``speed.py`` judges one run against them, ``speed_runs.py`` many runs' JSON and
 ``criterion_table.py`` the cases criterion times; ``speed_plots.py`` draws the threads'
@@ -32,3 +33,15 @@ INSERT_TEXT = f"{INSERT_S * 1e6:g} µs"
 PEER_TEXT = f"{PEER_RATIO:g}×"
 INTEL_TEXT = f"{INTEL_S:g} s"
 THREADS_TEXT = f"{THREADS_RATIO:g}×"
+
+
+def insert_judged(points: float) -> bool:
+    """Whether an insert case of ``points`` points (its median scan) is judged against
+    ``INSERT_S``: the target is for a 683-beam scan, not for sparse ones."""
+    return points >= INSERT_MIN_POINTS
+
+
+def intel_judged(scans: int) -> bool:
+    """Whether an odometry run over ``scans`` scans is judged against ``INTEL_S``: only the
+    whole Intel log is."""
+    return scans >= INTEL_SCANS
