@@ -87,9 +87,11 @@ class Cell:
 
 @dataclass(frozen=True)
 class Row:
-    """A row of the tables: its name, whether it is a target (else it only informs),
-    and its cell for a run's sections (``None``: the run did not time it)."""
+    """A row of the tables: a short ``key`` for code that looks a row up, its name,
+    whether it is a target (else it only informs), and its cell for a run's sections
+    (``None``: the run did not time it)."""
 
+    key: str
     name: str
     target: bool
     cell: Callable[[Sections], Cell | None]
@@ -310,37 +312,49 @@ def _memory(s: Sections) -> Cell | None:
 
 
 ROWS = (
-    Row("match sim / URG / URG ≥ 500 [ms]", True, _match),
-    Row(f"≥ {tg.PEER_TEXT} fastest peer (SICK / URG pairs / URG map / sim map)", True, _peers),
-    Row(f"insert ≤ {tg.INSERT_TEXT}", True, _insert),
-    Row(f"Intel ≤ {tg.INTEL_TEXT} (one thread)", True, _intel),
-    Row(f"≥ {tg.PEER_TEXT} fastest peer odometry (its s)", True, _odometry_peer),
-    Row("no map [s] (× fastest peer)", False, _no_map),
-    Row("linear (R²) / flat (padded / recent maps)", True, _sweeps),
+    Row("match", "match sim / URG / URG ≥ 500 [ms]", True, _match),
     Row(
-        f"two threads ≥ {tg.THREADS_TEXT}, started for each run (SHA-256; bundles)", True, _threads
+        "peers",
+        f"≥ {tg.PEER_TEXT} fastest peer (SICK / URG pairs / URG map / sim map)",
+        True,
+        _peers,
+    ),
+    Row("insert", f"insert ≤ {tg.INSERT_TEXT}", True, _insert),
+    Row("intel", f"Intel ≤ {tg.INTEL_TEXT} (one thread)", True, _intel),
+    Row("odometry_peer", f"≥ {tg.PEER_TEXT} fastest peer odometry (its s)", True, _odometry_peer),
+    Row("no_map", "no map [s] (× fastest peer)", False, _no_map),
+    Row("sweeps", "linear (R²) / flat (padded / recent maps)", True, _sweeps),
+    Row(
+        "threads",
+        f"two threads ≥ {tg.THREADS_TEXT}, started for each run (SHA-256; bundles)",
+        True,
+        _threads,
     ),
     Row(
+        "steady",
         f"two threads ≥ {tg.THREADS_TEXT}, keep matching",
         True,
         _thread_ratio("steady_ratio", "keep matching"),
     ),
     Row(
+        "pinned",
         f"two pinned workers ≥ {tg.THREADS_TEXT}",
         True,
         _thread_ratio("pinned_ratio", "pinned workers"),
     ),
     Row(
+        "many",
         f"one `match_many` call ≥ {tg.THREADS_TEXT}",
         True,
         _thread_ratio("many_ratio", "one match_many call"),
     ),
     Row(
+        "placement",
         "unpinned: on one vCPU at the first match / half-way; second thread ≥ 1 ms late (runs)",
         False,
         _placement,
     ),
-    Row("memory", False, _memory),
+    Row("memory", "memory", False, _memory),
 )
 
 
@@ -390,9 +404,17 @@ def met_every_target(cells: Sequence[Cell | None]) -> bool:
     return all(c is not None and c.met() is True for c, r in zip(cells, ROWS) if r.target)
 
 
-def _count(cells: Sequence[Cell | None]) -> str:
+def _tally(row: Row, cells: Sequence[Cell | None]) -> tuple[int, int] | None:
+    """How many of ``cells`` met ``row``, of how many were judged (``None``: none was,
+    or the row only informs)."""
+    if not row.target:
+        return None
     judged = [v for v in (c.met() for c in cells if c is not None) if v is not None]
-    return f"{sum(judged)} of {len(judged)}" if judged else "–"
+    return (sum(judged), len(judged)) if judged else None
+
+
+def _count(tally: tuple[int, int] | None) -> str:
+    return "–" if tally is None else f"{tally[0]} of {tally[1]}"
 
 
 def run_tables(runs: Sequence[Run], columns: int) -> list[str]:
@@ -408,7 +430,7 @@ def run_tables(runs: Sequence[Run], columns: int) -> list[str]:
         for i, row in enumerate(ROWS):
             col = [c[i] for c in cells]
             shown = " | ".join("–" if c is None else c.text() for c in col)
-            lines.append(f"| {row.name} | {shown} | {_count(col) if row.target else '–'} |")
+            lines.append(f"| {row.name} | {shown} | {_count(_tally(row, col))} |")
     return lines
 
 
@@ -421,13 +443,22 @@ def _span(parts: Sequence[Part]) -> str:
     return lo if lo == hi else f"{lo}–{hi}"
 
 
-def summary(runs: Sequence[Run]) -> list[str]:
-    """Each row's range and count over ``runs``, and the runs that met every target."""
+@dataclass(frozen=True)
+class Total:
+    """A row over many runs: each part's range as printed (a dash where no run measured
+    it), the whole cell as the summary prints it, and how many runs met the row of how
+    many were judged (``None`` for a row that only informs, or that no run timed)."""
+
+    row: Row
+    spans: tuple[str, ...]
+    text: str
+    count: tuple[int, int] | None
+
+
+def totals(runs: Sequence[Run]) -> list[Total]:
+    """Each row's range and count over ``runs``, in the order of ``ROWS``."""
     cells = [r.cells for r in runs]
-    lines = [
-        f"| target | {len(runs)} runs | met |",
-        "|---|---|---|",
-    ]
+    out = []
     for i, row in enumerate(ROWS):
         col = [c[i] for c in cells]
         shaped = [c for c in col if c is not None]
@@ -435,14 +466,23 @@ def summary(runs: Sequence[Run]) -> list[str]:
         # left out of the ranges, not of the count.
         same = [c for c in shaped if c.template == shaped[0].template] if shaped else []
         spans = (
-            shaped[0].template.format(
-                *(_span([c.parts[k] for c in same]) for k in range(len(same[0].parts)))
-            )
+            tuple(_span([c.parts[k] for c in same]) for k in range(len(same[0].parts)))
             if same
-            else "–"
+            else ()
         )
-        lines.append(f"| {row.name} | {spans} | {_count(col) if row.target else '–'} |")
-    every = [r.name for r, c in zip(runs, cells) if met_every_target(c)]
+        text = same[0].template.format(*spans) if same else "–"
+        out.append(Total(row, spans, text, _tally(row, col)))
+    return out
+
+
+def summary(runs: Sequence[Run]) -> list[str]:
+    """Each row's range and count over ``runs``, and the runs that met every target."""
+    lines = [
+        f"| target | {len(runs)} runs | met |",
+        "|---|---|---|",
+        *(f"| {t.row.name} | {t.text} | {_count(t.count)} |" for t in totals(runs)),
+    ]
+    every = [r.name for r in runs if met_every_target(r.cells)]
     lines += [
         "",
         f"Every target met in {len(every)} of {len(runs)} runs"

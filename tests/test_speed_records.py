@@ -1,0 +1,207 @@
+"""The speed numbers README.md and BENCHMARK.md quote over many runs agree with the runs.
+
+Every counted `benches/speed.py --json` run of the current VM is kept in `benches/runs/`;
+`benches/speed_runs.py` works each of issue 7's rows out over them (`totals`), and each
+table that quotes those rows must show its ranges (at the digits the table prints) and
+its counts of runs that met the target, and name the runs' number and first and last
+run. A new run added without the docs brought up to date fails here, as does a doc
+number copied wrong.
+"""
+
+from __future__ import annotations
+
+import re
+from decimal import Decimal
+from typing import Any, Optional
+
+import pytest
+
+from tests._benches import BENCHES, load_bench
+
+sr = load_bench("speed_runs")
+ROOT = BENCHES.parent
+RUNS = sorted(
+    (BENCHES / "runs").glob("run*.json"), key=lambda p: int(re.sub(r"\D", "", p.stem) or 0)
+)
+DASH = "\N{EN DASH}"
+TIMES = "\N{MULTIPLICATION SIGN}"
+NUMBER = r"\d+(?:\.\d+)?"
+RANGE = re.compile(rf"({NUMBER}){DASH}({NUMBER})")
+COUNT = re.compile(r"(\d+) of (\d+)")
+
+# A table's rows, by how their first cell starts: the parts of `speed_runs`' rows
+# (key, part) whose ranges the quoting cells must show, and the rows whose counts they
+# must show, in the order they show them; `None`: a row that quotes none of them.
+Quotes = dict[str, Optional[tuple[list[tuple[str, int]], list[str]]]]
+
+README_TARGETS: Quotes = {
+    "median match": ([("match", 0), ("match", 1), ("match", 2)], ["match"]),
+    f"≥ 3{TIMES} faster than the fastest peer": ([("peers", k) for k in range(4)], ["peers"]),
+    "insert of": ([("insert", 0)], ["insert"]),
+    "the whole Intel log": ([("intel", 0), ("intel", 1)], ["intel"]),
+    f"… and ≥ 3{TIMES}": ([("odometry_peer", 0), ("odometry_peer", 1)], ["odometry_peer"]),
+    "time per match": ([("sweeps", 0), ("sweeps", 1)], ["sweeps"]),
+    "two Python threads": ([("threads", 0)], ["threads"]),
+    "memory": ([("memory", 0), ("memory", 1)], []),
+}
+README_THREADS: Quotes = {
+    "started for each run": ([("threads", 0)], ["threads"]),
+    "that keep matching": ([("steady", 0)], ["steady"]),
+    "pinned": ([("pinned", 0)], ["pinned"]),
+    "one `match_many`": ([("many", 0)], ["many"]),
+}
+BENCHMARK_STATUS: Quotes = {
+    "`cargo bench` groups": None,
+    "match against small_gicp": ([], ["peers"]),
+    "median match": ([("match", 0), ("match", 1), ("match", 2)], ["match"]),
+    f"≥ 3{TIMES} faster than the fastest peer": ([("peers", 0), ("peers", 2)], ["peers"]),
+    "insert of": ([("insert", 0)], ["insert"]),
+    "the Intel log": ([("intel", 0)], ["intel"]),
+    f"… and ≥ 3{TIMES}": ([("odometry_peer", 0), ("odometry_peer", 1)], ["odometry_peer"]),
+    "time per match": ([("sweeps", 0), ("sweeps", 1)], ["sweeps"]),
+    "two Python threads": (
+        [("threads", 0), ("steady", 0), ("pinned", 0), ("many", 0)],
+        ["steady", "pinned", "many", "threads"],
+    ),
+    "memory": ([("memory", 0), ("memory", 1)], []),
+}
+
+
+@pytest.fixture(scope="module")
+def runs() -> list[Any]:
+    return [sr.read_run(p) for p in RUNS]
+
+
+@pytest.fixture(scope="module")
+def totals(runs: list[Any]) -> dict[str, Any]:
+    return {t.row.key: t for t in sr.totals(runs)}
+
+
+def flat(text: str) -> str:
+    """``text`` with each run of white space one space, as a reader sees it."""
+    return " ".join(text.split())
+
+
+def table(text: str, header: str) -> list[list[str]]:
+    """The rows (header first) of the Markdown table whose header line starts with
+    ``header``, each a list of its cells, stripped."""
+    lines = text.splitlines()
+    starts = [i for i, line in enumerate(lines) if line.strip().startswith(header)]
+    assert len(starts) == 1, f"{len(starts)} tables start with {header!r}"
+    rows = []
+    for line in lines[starts[0] :]:
+        line = line.strip()
+        if not line.startswith("|"):
+            break
+        if not line.startswith("|---"):
+            rows.append([c.strip() for c in line.strip("|").split("|")])
+    return rows
+
+
+def _decimals(number: str) -> int:
+    return len(number.partition(".")[2])
+
+
+def rounds_to(doc: str, ours: str) -> bool:
+    """Whether the number ``doc``, as a table prints it, is ``ours`` (as ``speed_runs``
+    prints it) rounded to ``doc``'s digits: the same number at the same digits; at fewer,
+    within half a unit of each one's last digit (``ours`` is itself rounded)."""
+    if _decimals(doc) > _decimals(ours):
+        return False
+    if _decimals(doc) == _decimals(ours):
+        return Decimal(doc) == Decimal(ours)
+    half = Decimal("0.5").scaleb(-_decimals(doc)) + Decimal("0.5").scaleb(-_decimals(ours))
+    return abs(Decimal(doc) - Decimal(ours)) <= half
+
+
+def shows(cell: str, span: str) -> bool:
+    """Whether ``cell`` shows the range ``span`` (low and high joined by an en dash, or
+    one number when every run gave the same)."""
+    if DASH in span:
+        lo, hi = span.split(DASH)
+        return any(rounds_to(a, lo) and rounds_to(b, hi) for a, b in RANGE.findall(cell))
+    return any(rounds_to(a, span) for a in re.findall(NUMBER, cell))
+
+
+def check(
+    rows: list[list[str]], columns: list[int], quotes: Quotes, totals: dict[str, Any]
+) -> None:
+    """Every row of the table is in ``quotes`` and its ``columns`` show what it names."""
+    seen = []
+    for cells in rows[1:]:
+        keys = [k for k in quotes if cells[0].startswith(k)]
+        assert len(keys) == 1, f"row {cells[0]!r}: {len(keys)} entries of the test name it"
+        seen.append(keys[0])
+        quoted = quotes[keys[0]]
+        if quoted is None:
+            continue
+        parts, counted = quoted
+        text = " ; ".join(cells[c] for c in columns)
+        for key, k in parts:
+            span = totals[key].spans[k]
+            assert shows(text, span), f"row {keys[0]!r}: {key} part {k} is {span}, not in {text!r}"
+        want = [f"{totals[k].count[0]} of {totals[k].count[1]}" for k in counted]
+        got = [f"{a} of {b}" for a, b in COUNT.findall(text)]
+        assert got == want, f"row {keys[0]!r}: counts {got}, the runs give {want}"
+    assert sorted(seen) == sorted(quotes), "a row the test names is missing from the table"
+
+
+def test_the_runs_are_whole_runs_of_one_machine(runs: list[Any]) -> None:
+    # read_run has raised on a run that stopped part-way
+    assert runs, "benches/runs/ holds no run"
+    assert len({r.machine.split(", commit")[0] for r in runs}) == 1, sr.machines(runs)
+    assert len({r.name for r in runs}) == len(runs)
+
+
+def test_readme_quotes_the_runs(runs: list[Any], totals: dict[str, Any]) -> None:
+    text = (ROOT / "README.md").read_text()
+    n, first, last = len(runs), runs[0].name, runs[-1].name
+    intro = text[text.index("### Issue 7's targets, against the peers") :]
+    intro = flat(intro[: intro.index("| target (issue 7) |")])
+    assert f"The {n} runs on this project's current VM" in intro
+    assert f"runs {first}{DASH}{last}" in intro
+    check(table(text, "| target (issue 7) |"), [1, 2], README_TARGETS, totals)
+    threads = table(text, "| two threads … |")
+    assert f"{n} runs)" in threads[0][1]
+    check(threads, [1], README_THREADS, totals)
+    # the rounds whose two threads began on one vCPU, over every run's rounds
+    rounds = [r.sections["threads"] for r in runs]
+    together = sum(t["one_cpu_first_runs"] for t in rounds)
+    read = sum(t["cpu_read_runs"] for t in rounds)
+    assert f"on the first one's vCPU in {together} of {read} rounds" in flat(text)
+
+
+def test_benchmark_status_table_quotes_the_runs(runs: list[Any], totals: dict[str, Any]) -> None:
+    text = (ROOT / "BENCHMARK.md").read_text()
+    rows = table(text, "| target (issue 7) | judged by |")
+    n, first, last = len(runs), runs[0].name, runs[-1].name
+    assert f"runs {first}{DASH}{last}" in rows[0][2]
+    check(rows, [2, 3], BENCHMARK_STATUS, totals)
+    assert f"(runs {first}{DASH}{last}, {n} runs on Intel" in flat(text)
+    assert f"Each target's numbers in the {n} runs" in flat(text)
+    assert f"![Issue 7's targets in runs {first}{DASH}{last} of benches/speed.py]" in text
+
+
+@pytest.mark.parametrize(
+    ("doc", "ours", "agree"),
+    [
+        ("12.6", "12.60", True),
+        ("16.2", "16.23", True),
+        ("48.3", "48.25", True),
+        ("16.3", "16.23", False),
+        ("12.60", "12.6", False),
+        ("0.131", "0.131", True),
+        ("0.132", "0.131", False),
+    ],
+)
+def test_a_quoted_number_rounds_from_the_runs(doc: str, ours: str, agree: bool) -> None:
+    assert rounds_to(doc, ours) is agree
+
+
+def test_a_quoted_range_is_found_in_its_cell() -> None:
+    cell = f"simulated 0.070{DASH}0.131 ms; real 12.6{DASH}16.2{TIMES}, 261 B"
+    assert shows(cell, f"12.60{DASH}16.23")
+    assert not shows(cell, f"12.60{DASH}16.33")
+    assert not shows(cell, f"0.070{DASH}0.130")
+    assert shows(cell, "261")
+    assert not shows(cell, "262")
