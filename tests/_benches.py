@@ -1,4 +1,5 @@
-"""Loading a module of ``benches/`` (not a package) into the tests."""
+"""Loading a module of ``benches/`` (not a package) into the tests, and reading the
+Markdown tables the benches print and the docs quote."""
 
 from __future__ import annotations
 
@@ -19,3 +20,8 @@ def load_bench(name: str) -> ModuleType:
     sys.modules[spec.name] = module
     spec.loader.exec_module(module)
     return module
+
+
+def cells(line: str) -> list[str]:
+    """The cells of one Markdown table row, stripped."""
+    return [c.strip() for c in line.strip().strip("|").split("|")]

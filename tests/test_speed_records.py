@@ -16,7 +16,7 @@ from typing import Any, Optional
 
 import pytest
 
-from tests._benches import BENCHES, load_bench
+from tests._benches import BENCHES, cells, load_bench
 
 sr = load_bench("speed_runs")
 ROOT = BENCHES.parent
@@ -94,7 +94,7 @@ def table(text: str, header: str) -> list[list[str]]:
         if not line.startswith("|"):
             break
         if not line.startswith("|---"):
-            rows.append([c.strip() for c in line.strip("|").split("|")])
+            rows.append(cells(line))
     return rows
 
 
@@ -128,15 +128,15 @@ def check(
 ) -> None:
     """Every row of the table is in ``quotes`` and its ``columns`` show what it names."""
     seen = []
-    for cells in rows[1:]:
-        keys = [k for k in quotes if cells[0].startswith(k)]
-        assert len(keys) == 1, f"row {cells[0]!r}: {len(keys)} entries of the test name it"
+    for entry in rows[1:]:
+        keys = [k for k in quotes if entry[0].startswith(k)]
+        assert len(keys) == 1, f"row {entry[0]!r}: {len(keys)} entries of the test name it"
         seen.append(keys[0])
         quoted = quotes[keys[0]]
         if quoted is None:
             continue
         parts, counted = quoted
-        text = " ; ".join(cells[c] for c in columns)
+        text = " ; ".join(entry[c] for c in columns)
         for key, k in parts:
             span = totals[key].spans[k]
             assert shows(text, span), f"row {keys[0]!r}: {key} part {k} is {span}, not in {text!r}"
@@ -177,8 +177,9 @@ def test_benchmark_status_table_quotes_the_runs(runs: list[Any], totals: dict[st
     n, first, last = len(runs), runs[0].name, runs[-1].name
     assert f"runs {first}{DASH}{last}" in rows[0][2]
     check(rows, [2, 3], BENCHMARK_STATUS, totals)
-    assert f"(runs {first}{DASH}{last}, {n} runs on Intel" in flat(text)
-    assert f"Each target's numbers in the {n} runs" in flat(text)
+    prose = flat(text)
+    assert f"(runs {first}{DASH}{last}, {n} runs on Intel" in prose
+    assert f"Each target's numbers in the {n} runs" in prose
     assert f"![Issue 7's targets in runs {first}{DASH}{last} of benches/speed.py]" in text
 
 

@@ -10,7 +10,7 @@ from typing import Any
 
 import pytest
 
-from tests._benches import load_bench
+from tests._benches import cells, load_bench
 
 sr = load_bench("speed_runs")
 TIMES = "\N{MULTIPLICATION SIGN}"
@@ -69,7 +69,7 @@ def row(lines: list[str], words: str) -> list[str]:
     met column included)."""
     hits = [line for line in lines if line.startswith("| ") and words in line.split(" | ")[0]]
     assert len(hits) == 1, hits
-    return [c.strip() for c in hits[0].strip("|").split("|")]
+    return cells(hits[0])
 
 
 def test_a_run_meeting_every_target(tmp_path: Path) -> None:
