@@ -4,7 +4,7 @@ Each pair runs both commands once, the order flipped from pair to pair, so that 
 of the machine's speed falls on both alike. The first ``--number`` is compared: per pair
 ``b / a - 1``, then the median, the mean with two standard errors and the number of
 pairs in which B was lower; any further numbers are reported as medians. This is how
-BENCHMARK.md's "Speed" sections compare builds (session 27 ran the same method from
+benches/SPEED_LOG.md's sessions compare builds (session 27 ran the same method from
 shell scripts).
 
 Run, e.g. two builds of the ``replay`` example, or two builds of the extension in

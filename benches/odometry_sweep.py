@@ -6,7 +6,8 @@ radians, as the config takes them) or ``"levels=4"``; the empty setting ``""`` i
 default configuration. For each log and setting this prints the time of the loop (the
 mapper read at the end included), the scans added to the loop's map (and of them, taken
 by its matching grid), the scans whose kept match ran the rotational multi-start, and the
-relation error of ``benches/datasets.py``. Results are in BENCHMARK.md, "Speed".
+relation error of ``benches/datasets.py``. Results are in benches/SPEED_LOG.md, sessions
+14-24.
 
 Run from the repository root::
 

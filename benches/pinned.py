@@ -2,7 +2,7 @@
 
 For the thread section of ``benches/speed.py``. On this project's VM the kernel places a
 thread woken by a busy thread on the waker's own vCPU, even with the other vCPU idle
-(``sched_switch`` / ``sched_wakeup`` traces in BENCHMARK.md, "Speed", session 29): the
+(``sched_switch`` / ``sched_wakeup`` traces in benches/SPEED_LOG.md, session 29): the
 second of two matching threads then waits there for the scheduler tick (4 ms at
 ``CONFIG_HZ=250``) or shares that vCPU for a while. A thread pinned to its own core
 cannot be placed on the other's, which is what a program that wants two cores' worth of

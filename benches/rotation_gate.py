@@ -1,4 +1,4 @@
-"""The sweep behind ``MatchOptions::rotation_gate`` (BENCHMARK.md, "Speed").
+"""The sweep behind ``MatchOptions::rotation_gate`` (benches/SPEED_LOG.md, sessions 9 and 11).
 
 Over several pyramid levels the matcher's rotational multi-start runs only when the first
 stage's solve from the guess scores below the gate per scan point. For each gate this

@@ -8,7 +8,7 @@ only for scans whose match without them looks poor (``inf``: on every scan). Thi
 the time of the loop (the mapper read at the end included), the scans whose kept match ran
 the multi-start, and the relation error of ``benches/datasets.py``; with ``--no-odometry``
 the logs' odometry is dropped (constant-velocity prior only), where the turned starts
-matter more. Results are in BENCHMARK.md, "Speed".
+matter more. Results are in benches/SPEED_LOG.md, sessions 8-12.
 
 Run from the repository root::
 

@@ -1,4 +1,6 @@
-"""The sweep behind the default ``skip_levels`` of ``NdtGrid.match`` (BENCHMARK.md, "Speed").
+"""The sweep behind the default ``skip_levels`` of ``NdtGrid.match``.
+
+Results are in benches/SPEED_LOG.md, sessions 18 and 43.
 
 For each variant (skipped pyramid levels, and the default's level count against 5 levels)
 this prints the successes of the 2 cm ``match`` on the sets of ``benches/sigma_floor.py``

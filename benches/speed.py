@@ -109,7 +109,7 @@ INTEL_CORRECTED = REAL / "radish-gfs-corrected" / "intel-corrected.log.gz"
 # Scans merged into one for the thread section's second control.
 THREAD_BUNDLE = 20
 # s: a two-thread run whose second thread's first match began this long after the clock
-# counts as started late (BENCHMARK.md, "Speed", session 46: such runs had a median
+# counts as started late (benches/SPEED_LOG.md, session 46: such runs had a median
 # ratio of 1.46 against 1.78).
 LATE_START = 1e-3
 
@@ -1164,7 +1164,7 @@ def points_sweep(args: argparse.Namespace) -> list[dict[str, float]]:
     Every scan and start is drawn first, in the order of the beam counts; the matches
     are then timed with the beam counts in turn (for each map and start, each count once),
     so that a spell of the machine slows every count alike instead of the one timed
-    during it (BENCHMARK.md, "Speed", session 47)."""
+    during it (benches/SPEED_LOG.md, session 47)."""
     pts, poses = sim_urg_scans(10_000, args.seed)
     room = sim.sticks_room()
     rng = np.random.default_rng(args.seed + 1)
@@ -1402,7 +1402,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         the thread is on at its first match and half-way through into ``mid``
         (``pinned.current_cpu``: glibc's ``sched_getcpu``, about 0.1 µs, the GIL kept).
         A read of /proc at the first match instead, about 14 µs, lowered the ratio itself
-        (BENCHMARK.md, "Speed", session 44)."""
+        (benches/SPEED_LOG.md, session 44)."""
         reads = (0, len(part) // 2) if mid is not None else ()
         start = time.perf_counter()
         for i, (p, g) in enumerate(part):
@@ -1583,7 +1583,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         # `match_many` in rounds of its own, after the others: run between the rounds
         # above, its work on the calling thread lowered the next unpinned two-thread
         # run's ratio by about 0.3 with the controls unchanged (8 alternated pairs;
-        # BENCHMARK.md, "Speed", session 32), so the Python threads are timed as they
+        # benches/SPEED_LOG.md, session 32), so the Python threads are timed as they
         # were before `match_many` joined the section.
         for _ in progress(range(args.thread_reps), "match_many"):
             t1, c1, r1 = many(1)
@@ -1715,7 +1715,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             f"{', '.join(f'{1e6 * x:.0f}' for x in pin_lates)} µs after the first's. "
             "Unpinned, this VM's kernel may wake a thread on the vCPU of the busy thread "
             "that woke it, with the other vCPU idle; it then waits there for the "
-            'scheduler\'s tick or shares that vCPU (BENCHMARK.md, "Speed", session 29).',
+            "scheduler's tick or shares that vCPU (benches/SPEED_LOG.md, session 29).",
         ]
     else:
         pin_rows, pin_text = [], ["", "Pinned workers: not measured (no two CPUs to pin to)."]
@@ -1784,7 +1784,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             "(the GIL released once for the batch; the calling thread and a helper started for "
             "the batch each take the next scan not yet taken), on the calling thread alone and "
             f"then on every core, in {args.thread_reps} rounds of its own after the runs above "
-            '(between them it lowered the unpinned ratio: BENCHMARK.md, "Speed", session '
+            "(between them it lowered the unpinned ratio: benches/SPEED_LOG.md, session "
             "32); the ratio is taken against the faster of its own "
             "one-thread row and the first row. Per run (one thread's time over every core's "
             "right after it): "

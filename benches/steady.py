@@ -5,7 +5,7 @@ runs.
 The section's main row starts two threads for each run of 300 matches each, about 15 ms:
 where the kernel first puts a new thread weighs on such a run. On a VM whose kernel
 starts the second thread on the first one's vCPU, the two can share that vCPU for several
-milliseconds before the load balancer moves one (BENCHMARK.md, "Speed", sessions 29 and
+milliseconds before the load balancer moves one (benches/SPEED_LOG.md, sessions 29 and
 54). :func:`keep_matching` times threads that match for a whole second or more, so that
 such a start is a small part of the run, as in a loop that runs for minutes.
 """

@@ -2,7 +2,7 @@
 
 ``NdtGrid.match`` releases the GIL while the core works, so two threads matching
 different scans against one map run in parallel. On Linux, pin each worker thread to
-its own core: some kernels (this project's VM, BENCHMARK.md "Speed", session 29) wake a
+its own core: some kernels (this project's VM, benches/SPEED_LOG.md, session 29) wake a
 thread on the core of the busy thread that woke it, and the two then take turns on one
 core for milliseconds. ``os.sched_setaffinity(0, ...)`` in a thread pins that thread
 only; a ``ThreadPoolExecutor`` initializer runs once in each worker.
@@ -17,7 +17,7 @@ prints the matches per second of one thread, of two pinned workers and of one
 ``match_many`` call, and checks that all give the same poses, bit for bit. The gain is
 what the two cores have free: on this project's 2-vCPU VM, pinned workers gave 1.4-1.5x
 in a phase in which the VM gave GIL-free work (SHA-256) 1.5x, and 1.59-2.00x over
-thirteen runs of ``benches/speed.py``'s thread section (BENCHMARK.md, "Speed", session
+thirteen runs of ``benches/speed.py``'s thread section (benches/SPEED_LOG.md, session
 29; ``match_many`` in session 30).
 """
 

@@ -211,7 +211,7 @@ class NdtGrid:
         same surfaces, so that upkeep, most of a single insert's work, is
         shared: building a map from a log whose poses are known (ground truth,
         a finished SLAM run, an optimised trajectory) takes less time per scan
-        the longer the batch (BENCHMARK.md, "Speed", session 37). The GIL is
+        the longer the batch (benches/SPEED_LOG.md, session 37). The GIL is
         released once for the whole batch; matches wait for it to finish. The
         keys of the cells each scan changed (8 bytes a cell and scan) wait for
         the batch's end, so a very long log is best given in batches of some
@@ -377,7 +377,7 @@ class NdtGrid:
             held-out 6151 / 6064 against 6139 / 6060; from starts up to
             ±1.2 m and ±30° as many or more) and matches 16-27 % faster; an
             insert then keeps one level's distributions fewer
-            (``BENCHMARK.md``, "Speed", session 18).
+            (``benches/SPEED_LOG.md``, session 18).
         coarse_model : bool, default True
             From the second stage on, score the coarser level of the stage by
             its second-order expansion about the stage's start (the same

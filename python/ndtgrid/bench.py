@@ -267,7 +267,7 @@ def processor_name(cpuinfo: str | None = None) -> str:
 
     A virtual machine's ``model name`` can be as vague as ``AMD EPYC`` for several
     generations of processor, which ran the same code up to twice as fast as each other
-    (``BENCHMARK.md``, "Speed", session 34), and an ARM board's ``/proc/cpuinfo`` often
+    (``benches/SPEED_LOG.md``, session 34), and an ARM board's ``/proc/cpuinfo`` often
     has no model name at all. So the processor's identifiers follow the name (x86:
     family, model, stepping; ARM: implementer, part, variant, revision). The build of
     the core's kernels that runs is :func:`ndtgrid._core.vector_extension`.

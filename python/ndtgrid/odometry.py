@@ -54,7 +54,7 @@ class OdometryConfig:
         32 cm cells (``levels``), measured on the five benchmark logs against the map's
         own 0.1 m, 5 degrees, 200 and 64 cm: relation errors within 1 mm with the logs'
         odometry, lower on three logs without it, and a third fewer inserts and window
-        removals for the matching grid (``BENCHMARK.md``, "Speed", session 14).
+        removals for the matching grid (``benches/SPEED_LOG.md``, session 14).
     match_insert_angle : float, default 7.5 degrees
         ... or turned this much [rad].
     match_map_window : int, default 130
@@ -114,7 +114,7 @@ class OdometryConfig:
         than ``rotation_tolerance``) on the fine level; each coarser level scales both
         by its cell size. :meth:`NdtGrid.match` stops at 1e-4 m; the loop at 0.3 mm,
         for about a tenth fewer instructions, with relation errors on the five benchmark
-        logs within the loop's own run-to-run spread (BENCHMARK.md, "Speed", session 16).
+        logs within the loop's own run-to-run spread (benches/SPEED_LOG.md, session 16).
     rotation_tolerance : float, default 1e-4
         The rotation of that test [rad].
     max_step_cells : float, default 2.0
@@ -125,8 +125,8 @@ class OdometryConfig:
         Pyramid levels the matcher runs coarse to fine (see ``NdtGrid.match``); by
         default as many as keep the coarsest cell at most 0.32 m (5 on 2 cm cells; a match
         alone goes up to 0.64 m): from a motion prior the 64 cm stage adds little, and
-        without odometry it made the benchmark logs' matches worse (``BENCHMARK.md``,
-        "Speed", session 14).
+        without odometry it made the benchmark logs' matches worse (``benches/SPEED_LOG.md``,
+        session 14).
     skip_levels : tuple of int, default (1,)
         Pyramid levels the matcher passes over (``NdtGrid.match(skip_levels=...)``;
         ``()``: every level). The loop skips the 4 cm level: 32, 16, 8 and 2 cm cells,
@@ -134,7 +134,7 @@ class OdometryConfig:
         of the distributions the matching grid's updates compute and a quarter of a
         scan's evaluations: 17 % fewer of the loop's instructions, with relation errors
         on the five benchmark logs within the loop's own run-to-run spread
-        (``BENCHMARK.md``, "Speed", session 17).
+        (``benches/SPEED_LOG.md``, session 17).
     coarse_rotation_search : float, default 0.15
         The matcher's rotational multi-start on its coarsest level [rad]
         (``NdtGrid.match(rotation_search=...)``); 0 turns it off.
@@ -183,7 +183,7 @@ class OdometryConfig:
         and, on Linux, may run only on the CPUs the thread that makes it may run on
         (a thread inherits them): make the :class:`Odometry` before pinning the
         loop's thread to one CPU, or the helper shares that CPU (921 simulated
-        scans: 0.087-0.090 s against 0.054-0.069 s, BENCHMARK.md, "Speed", session
+        scans: 0.087-0.090 s against 0.054-0.069 s, benches/SPEED_LOG.md, session
         33). Ignored with ``match_filtered_map`` (the mapper then takes each scan at
         once).
     build_map : bool, default True
@@ -195,7 +195,7 @@ class OdometryConfig:
         poses are the same bit for bit (they never depend on the map unless
         ``match_filtered_map``, which needs it: ``ValueError``). On the Intel log it
         used 50-55 % of the default's CPU time, both threads counted, and 86-103 % of
-        its wall time (``BENCHMARK.md``, "Speed", session 28).
+        its wall time (``benches/SPEED_LOG.md``, session 28).
     """
 
     min_range: float = 0.0

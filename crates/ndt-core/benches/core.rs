@@ -58,7 +58,7 @@ fn bench_insert_with(c: &mut Criterion, name: &str, prepared: bool) {
             // first insert copied it whole (once per build in a loop, but on
             // every timed clone here: at 2 cm and 683 points one level's 426
             // entries); now a built table has the room of its level's sums
-            // (BENCHMARK.md, "Speed", sessions 51 and 52).
+            // (benches/SPEED_LOG.md, sessions 51 and 52).
             let mut grid = grid;
             if prepared {
                 let _ = grid.match_scan(&pts, pose, &MatchOptions::default());

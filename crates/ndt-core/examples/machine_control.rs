@@ -11,7 +11,7 @@
 //!   64-byte line in a random cycle): the latency of one load from L1, L2,
 //!   L3 and memory.
 //!
-//! BENCHMARK.md, "Speed", session 41, used it to show that the Zen 4 VM's
+//! benches/SPEED_LOG.md, session 41, used it to show that the Zen 4 VM's
 //! slow spells leave the latency-bound chain as it is.
 
 use std::hint::black_box;

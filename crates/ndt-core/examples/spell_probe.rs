@@ -17,7 +17,7 @@
 //! windows of 30 consecutive inserts (about 5 ms). A window whose inserts
 //! took 1.3× their usual time or more is slow; the program prints, for each
 //! control, its median ratio in the slow windows and in the others.
-//! BENCHMARK.md, "Speed", session 48, used it to show that in the spells the
+//! benches/SPEED_LOG.md, session 48, used it to show that in the spells the
 //! loads slow with the insert and the arithmetic does not.
 
 use std::error::Error;

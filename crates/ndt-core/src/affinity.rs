@@ -10,8 +10,8 @@
 //! match. The count used to be asked once per process, so a batch called
 //! from a thread pinned to one CPU (as `README.md` tells users to pin their
 //! matching threads) after one from an unpinned thread started a helper on
-//! that same CPU: 0.97× the one-thread rate in 30 rounds (BENCHMARK.md,
-//! "Speed", session 33). Now the calling thread's affinity is read on every
+//! that same CPU: 0.97× the one-thread rate in 30 rounds (benches/SPEED_LOG.md,
+//! session 33). Now the calling thread's affinity is read on every
 //! call (one system call) and `available_parallelism` only when its answer
 //! cannot follow from the last one's.
 

@@ -615,7 +615,7 @@ impl<'a> ChangedSums<'a> {
 /// remembered in 64 slots by the ancestor index's low 3 bits on each axis:
 /// a cell's neighbours, and the touched cells' runs, lie under nearby
 /// ancestors. Each miss is a hash probe: 245 an insert of `insert_case`
-/// with 16 slots, 223 with 64 (BENCHMARK.md, "Speed", session 43).
+/// with 16 slots, 223 with 64 (benches/SPEED_LOG.md, session 43).
 struct AncestorKinds<'a> {
     changed: &'a FxHashSet<CellKey>,
     /// The shape level's sums: which ancestors hold cells.
@@ -852,7 +852,7 @@ mod tests {
     /// A level's distributions are built with the room its sums have: a table
     /// built exactly full was copied whole by the first insert that added a
     /// cell to the level, and by every insert into a fresh copy of a grid
-    /// (criterion's `insert` group; BENCHMARK.md, "Speed", session 52).
+    /// (criterion's `insert` group; benches/SPEED_LOG.md, session 52).
     #[test]
     fn a_built_table_has_the_room_of_its_sums_and_keeps_it_through_an_insert() {
         for shape_cell in [0.32, 0.0] {

@@ -235,7 +235,7 @@ impl NdtGrid {
     /// The staged points take `spare`'s storage: the odometry loop stages
     /// every scan its matching grid takes, and a new vector each time took
     /// the allocator's lock, which the mapper's helper thread may hold
-    /// (BENCHMARK.md, "Speed", session 27).
+    /// (benches/SPEED_LOG.md, session 27).
     pub(crate) fn stage(
         &self,
         points: &[[f64; 2]],
@@ -440,7 +440,7 @@ impl NdtGrid {
     /// from the occupancy masks (see [`crate::occupancy`]). It read the pyramid's
     /// 32 cm and 8 cm levels before (the same blocks on a 2 cm grid, the
     /// same answers): `replay intel3k odometry 1 inline`, callgrind, in
-    /// BENCHMARK.md, "Speed", session 19.
+    /// benches/SPEED_LOG.md, session 19.
     pub fn occupancy_probe(&self) -> OccupancyProbe<'_> {
         self.pyramid.occupied().probe()
     }

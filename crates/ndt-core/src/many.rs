@@ -12,7 +12,7 @@
 //! than woken from a pool: a new thread goes to the idlest core, whereas a
 //! sleeping pool thread woken by a busy one may be put on the waker's core
 //! and wait there for the scheduler's tick (seen on this project's VM with
-//! rayon's pool: BENCHMARK.md, "Speed", session 30). A helper costs about
+//! rayon's pool: benches/SPEED_LOG.md, session 30). A helper costs about
 //! 0.1 ms before its first scan is done, so a batch starts one only for
 //! every [`MIN_SCANS_PER_THREAD`] scans.
 
@@ -91,7 +91,7 @@ impl NdtGrid {
 /// scans (about 0.1 ms each) on 2 cores ran at 0.74, 0.86 and 1.22× the
 /// one-thread rate with a helper for any batch (and the cores asked on
 /// every call), at 1.00, 0.99–1.01 and 1.45–1.51× with this bound and
-/// the count of cores asked once (BENCHMARK.md, "Speed", session 30; the
+/// the count of cores asked once (benches/SPEED_LOG.md, session 30; the
 /// count now comes from [`crate::affinity::threads_for_caller`]).
 const MIN_SCANS_PER_THREAD: usize = 2;
 

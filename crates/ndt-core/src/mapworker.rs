@@ -17,7 +17,7 @@
 //! (`OdometryConfig::background_mapper` off) the scans are batched the same
 //! way and each full batch runs at once, as a helper would run it: a scan
 //! at a time, the coarser levels took 9 % of the Intel loop (callgrind,
-//! BENCHMARK.md, "Speed", session 25). Only a loop that matches against the
+//! benches/SPEED_LOG.md, session 25). Only a loop that matches against the
 //! mapper's grid updates it scan by scan. A process that forks
 //! keeps only the forking thread: in the child the helper is gone, so the
 //! mapper is then updated in line, and batches the parent's helper still
@@ -32,7 +32,7 @@
 //! points) and drops the cells no kept scan hits. Behind the loop, that
 //! bookkeeping is the helper's: on the first 3000 Intel scans the loop's
 //! thread ran 2.7 % fewer instructions, and the default loop took about
-//! 5 % less time (BENCHMARK.md, "Speed", session 26).
+//! 5 % less time (benches/SPEED_LOG.md, session 26).
 
 use std::fmt;
 use std::ops::Deref;
@@ -96,7 +96,7 @@ impl MapWindow {
 /// Batches the helper is done with, emptied, and their scans: the loop
 /// takes the next ones' storage from them. Memory the loop's thread
 /// allocated and the helper's thread freed made both threads wait for
-/// glibc's lock of the loop's arena (BENCHMARK.md, "Speed", session 27).
+/// glibc's lock of the loop's arena (benches/SPEED_LOG.md, session 27).
 /// The loop makes a scan only when none is spare, so no more scans exist
 /// than were once on their way at the same time (at most
 /// `SPARE_BATCHES` batches).

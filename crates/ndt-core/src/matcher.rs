@@ -145,7 +145,7 @@ pub struct MatchOptions {
     /// in a wrong rotational basin, and a turned start could only add a few
     /// points. `inf` = always (the method before this gate); 0 = never.
     /// Measured with the success sets of `benches/sigma_floor.py`'s pairs
-    /// (`benches/rotation_gate.py`, BENCHMARK.md "Speed"): at 0.9, 6182 /
+    /// (`benches/rotation_gate.py`, benches/SPEED_LOG.md, session 9): at 0.9, 6182 /
     /// 6052 successes of 7680 local / wide starts on real SICK pairs against
     /// 6189 / 6054 always, the same on held-out SICK, URG-04LX and
     /// simulated pairs; the median match of real URG-04LX scans of at least
@@ -223,7 +223,7 @@ pub struct MatchOptions {
 /// scans of at least 500 points 16–27 % faster in three runs (0.141 against
 /// 0.187 ms in the last), and the distributions an insert keeps up to date
 /// one level fewer (`insert_loop`: 1.04 → 0.89 M instructions per 683-point
-/// insert). BENCHMARK.md, "Speed", session 18.
+/// insert). benches/SPEED_LOG.md, session 18.
 pub const DEFAULT_SKIP_LEVELS: u32 = 1 << 1;
 
 /// Smallest scan [`MatchOptions::parallel`] splits: 1024 points gained
@@ -532,7 +532,7 @@ impl<'a> MatchPairs<'a> {
 /// chunk's pairs kept instead, all chunks together no longer fit in the
 /// caches (`large_probe`, 32000 points, `RAYON_NUM_THREADS=1`, the pairs kept
 /// in chunks of 2048 points: 6.5–6.9 ms, against 4.3 ms streamed on one
-/// thread; BENCHMARK.md, "Speed", session 53).
+/// thread; benches/SPEED_LOG.md, session 53).
 fn evaluate_chunks<F>(points: &[[f64; 2]], weights: Option<&[f64]>, chunk_terms: F) -> PassTerms
 where
     F: Fn(&[[f64; 2]], Option<&[f64]>) -> PassTerms + Sync,
@@ -759,7 +759,7 @@ impl NdtGrid {
     /// outside the pool would hand every evaluation to the pool and sleep
     /// until it is done, a wake-up each way per evaluation, about 12 a
     /// match (`large_probe`, 32000 points in chunks of 2048: 2.4–2.5 ms
-    /// against 2.6–3.1 ms; BENCHMARK.md, "Speed", session 53).
+    /// against 2.6–3.1 ms; benches/SPEED_LOG.md, session 53).
     pub(crate) fn match_checked(
         &self,
         points: &[[f64; 2]],

@@ -22,7 +22,7 @@ type Entry = (usize, Pose2, Order, PassTerms);
 
 /// The last few (8) evaluations of whole-scan score terms, by level, held
 /// in place (a vector of them, grown in each match, took the allocator's
-/// lock: BENCHMARK.md, "Speed", session 27).
+/// lock: benches/SPEED_LOG.md, session 27).
 #[derive(Debug)]
 pub struct LevelMemo {
     /// Filled in order, then each next one replaces the oldest.

@@ -9,7 +9,7 @@
 //! be brought up to date (a deferral, `NdtGrid::deferral`). A grid that is
 //! never walked (the odometry loop's matching grid) never builds it. With
 //! the 32 × 32 and 8 × 8 blocks added to the other two, the odometry
-//! helper's instructions fell by 7 % (BENCHMARK.md, "Speed", session 24).
+//! helper's instructions fell by 7 % (benches/SPEED_LOG.md, session 24).
 
 use std::sync::OnceLock;
 

@@ -46,7 +46,7 @@ pub const ODOMETRY_SIGMA_FLOOR: f64 = 0.005;
 /// errors ACES 0.21 / 0.34 m, MIT Killian 0.52 / 0.88 m). The loop is
 /// chaotic: 0.095, 0.105 or 0.11 mm instead of 0.1 mm already moved ACES and
 /// MIT Killian by up to 1 mm and their largest errors to 0.29–0.32 /
-/// 0.51–1.28 m (BENCHMARK.md, "Speed", session 16). 0.5 mm took ACES past
+/// 0.51–1.28 m (benches/SPEED_LOG.md, session 16). 0.5 mm took ACES past
 /// that spread (0.043 ± 0.052 m, largest 0.80 m).
 pub const ODOMETRY_TRANSLATION_TOLERANCE: f64 = 3e-4;
 
@@ -61,7 +61,7 @@ pub const ODOMETRY_TRANSLATION_TOLERANCE: f64 = 3e-4;
 /// 0.028–0.029 m, ACES 0.039–0.045 m against 0.040–0.046 m with every level,
 /// FR079 0.025, MIT CSAIL 0.029, MIT Killian 0.042–0.044 against 0.042–0.044
 /// m; the largest errors in the same ranges), and without odometry ACES and
-/// MIT Killian did better, MIT CSAIL 3 mm worse (BENCHMARK.md, "Speed",
+/// MIT Killian did better, MIT CSAIL 3 mm worse (benches/SPEED_LOG.md,
 /// session 17). Skipping 16 cm instead kept the errors too but saves less;
 /// skipping 8 cm (ACES 0.042 ± 0.044 m, largest 0.63 m) or 4 and 16 cm
 /// together (ACES largest 0.96 m, MIT Killian 1.79 m) did worse in single
@@ -113,7 +113,7 @@ pub struct OdometryConfig {
     /// 0.15 m, 7.5° and a window of 130 scans (about as far back along the
     /// path as 200 scans 10 cm apart), with matches up to 32 cm cells
     /// ([`OdometryConfig::matcher`]): measured with `benches/odometry_sweep.py`
-    /// on the five benchmark logs (BENCHMARK.md, "Speed", session 14) against
+    /// on the five benchmark logs (benches/SPEED_LOG.md, session 14) against
     /// the map's own 0.1 m, 5°, 200 and 64 cm. With the logs' odometry the
     /// relation errors stayed within 1 mm (Intel 0.028 against 0.030 m, MIT
     /// Killian 0.042 against 0.045 m); without it they were lower on three
@@ -144,7 +144,7 @@ pub struct OdometryConfig {
     /// without odometry stayed at the origin (0.736 m relation error) with
     /// 0, and tracked (0.072 m) with 2. With odometry the five benchmark
     /// logs gave the same relation errors, ACES 0.039 against 0.040 m
-    /// (BENCHMARK.md, "Speed", session 9). Since the loop passes over the
+    /// (benches/SPEED_LOG.md, session 9). Since the loop passes over the
     /// 4 cm level ([`ODOMETRY_SKIP_LEVELS`]), ACES's first match without
     /// odometry is accepted anyway and 0 and 2 give the same run (0.057 m);
     /// matching on every level, 0 still leaves it at the origin (session 17).
@@ -186,7 +186,7 @@ pub struct OdometryConfig {
     /// [`MatchOptions::rotation_gate`]: this gate decides.)
     ///
     /// 0.8 measured on the five benchmark logs (`benches/rotation_sweep.py`,
-    /// BENCHMARK.md, "Speed"): with their odometry, mean relation errors
+    /// benches/SPEED_LOG.md, session 9): with their odometry, mean relation errors
     /// equal to those with the multi-start on every scan or lower (MIT
     /// Killian 0.045 m against 0.048 m), in 17 % less time on Intel, with
     /// 0.3–1.6 % of the scans running the multi-start; without odometry the
@@ -208,7 +208,7 @@ pub struct OdometryConfig {
     /// [`ODOMETRY_COARSEST_CELL`] (5 levels, 2–32 cm, on 2 cm cells), not
     /// 64 cm as a match alone: from a motion prior the 64 cm stage adds
     /// little, and without odometry it made the benchmark logs' matches
-    /// worse (BENCHMARK.md, "Speed", session 14), and of those it passes
+    /// worse (benches/SPEED_LOG.md, session 14), and of those it passes
     /// over the 4 cm level ([`ODOMETRY_SKIP_LEVELS`]). Its Newton steps stop at
     /// [`ODOMETRY_TRANSLATION_TOLERANCE`] (0.3 mm on the fine level), not a
     /// match's 0.1 mm.
@@ -239,7 +239,7 @@ pub struct OdometryConfig {
     /// 2 cores (BENCHMARK.md, "Speed"). The helper starts with the
     /// [`Odometry`] and inherits the CPU affinity of the thread that makes
     /// it (Linux): made on a thread pinned to one CPU, it shares that CPU
-    /// with the loop (BENCHMARK.md, "Speed", session 33). Ignored with
+    /// with the loop (benches/SPEED_LOG.md, session 33). Ignored with
     /// [`OdometryConfig::match_filtered_map`] (the loop then matches against
     /// the mapper's grid, so it takes each scan at once).
     pub background_mapper: bool,
@@ -251,7 +251,7 @@ pub struct OdometryConfig {
     /// depend on the map ([`OdometryConfig::match_filtered_map`] aside,
     /// which needs it). On the Intel log it used 50–55 % of the default's
     /// CPU time, both threads counted, and 86–103 % of its wall time
-    /// (BENCHMARK.md, "Speed", session 28; 37–43 % and 64–94 % in session
+    /// (benches/SPEED_LOG.md, session 28; 37–43 % and 64–94 % in session
     /// 21).
     pub build_map: bool,
 }

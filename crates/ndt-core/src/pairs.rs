@@ -66,7 +66,7 @@ pub struct ScanPairs<'a> {
 /// The vectors of a [`ScanPairs`]. A dropped one's go to the next one made
 /// on the same thread: the odometry loop makes 8 a scan, and each
 /// allocation on its thread may wait for the allocator's lock while the
-/// mapper's helper holds it (glibc; BENCHMARK.md, "Speed", session 26).
+/// mapper's helper holds it (glibc; benches/SPEED_LOG.md, session 26).
 #[derive(Debug, Default)]
 struct Storage {
     chunks: Vec<Chunk>,
@@ -92,8 +92,8 @@ impl Storage {
     /// padding lanes' pairs; the first evaluation empties `known` (nothing
     /// is paired yet), so every point's lane has its pair and kept key
     /// written; `cell_keys` writes `fresh`, `valid` and `same`. Zeroing the
-    /// chunks instead took 4.7 % of the loop's instructions (BENCHMARK.md,
-    /// "Speed", session 27).
+    /// chunks instead took 4.7 % of the loop's instructions (benches/SPEED_LOG.md,
+    /// session 27).
     fn sized(mut self, n: usize) -> Self {
         // `resize` keeps the first `n` as they are (truncating any more).
         self.chunks.resize(n, Chunk::default());

@@ -60,7 +60,7 @@ pub struct Pyramid {
     /// Emptied key vectors given back, the storage of the next updates'
     /// results: the odometry loop updates its matching grid every few
     /// scans, and each new vector took the allocator's lock, which the
-    /// mapper's helper thread may hold (BENCHMARK.md, "Speed", session 27).
+    /// mapper's helper thread may hold (benches/SPEED_LOG.md, session 27).
     spare: Vec<Vec<CellKey>>,
     /// Per level, per index of a cell's value: the number of the last
     /// update that met the cell ([`Stamps`]).

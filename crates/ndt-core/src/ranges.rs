@@ -72,7 +72,7 @@ fn points_along(
 ) -> Vec<[f64; 2]> {
     // Room for every beam at once: collecting a filter grows the vector
     // from a few points by doubling (6 reallocations for 180 beams, 0.5 % of
-    // the odometry loop's instructions, BENCHMARK.md "Speed", session 20).
+    // the odometry loop's instructions, benches/SPEED_LOG.md, session 20).
     points.clear();
     points.reserve(ranges.len());
     points.extend(
@@ -95,8 +95,8 @@ pub struct BeamDirections {
     directions: Vec<(f64, f64)>,
     /// Points given back ([`BeamDirections::give_back`]): the next
     /// points' storage. A new vector a scan took the allocator's lock
-    /// twice, which a mapper's helper thread may hold (BENCHMARK.md,
-    /// "Speed", session 27).
+    /// twice, which a mapper's helper thread may hold (benches/SPEED_LOG.md,
+    /// session 27).
     spare: Vec<[f64; 2]>,
 }
 

@@ -8,8 +8,8 @@
 //! blocks of 16 × 16 cells, found through a hash map of blocks but for the
 //! last block of each parity asked about: most questions are a compare and a
 //! bit test, not a hashed look-up. (8 × 8 blocks, one word each, hashed
-//! twice as often: the Intel loop ran 0.4 % more instructions; BENCHMARK.md,
-//! "Speed", session 17.)
+//! twice as often: the Intel loop ran 0.4 % more instructions; benches/SPEED_LOG.md,
+//! session 17.)
 
 use rustc_hash::FxHashMap;
 

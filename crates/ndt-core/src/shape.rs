@@ -161,7 +161,7 @@ impl ShapeMemo {
 
     /// Forgets every shape, keeping the storage for the next update's
     /// (each update's shapes grew new vectors: 0.4 % of an insert's
-    /// instructions, BENCHMARK.md, "Speed", session 27). Runs of more than
+    /// instructions, benches/SPEED_LOG.md, session 27). Runs of more than
     /// `max_runs` shape levels and options are dropped.
     pub fn clear(&mut self, max_runs: usize) {
         if self.runs.len() > max_runs {

@@ -278,7 +278,7 @@ impl<T> CellTable<T> {
     ///
     /// Inline: a shaped update writes each touched cell's mean with it (about
     /// 650 calls an insert), and the call cost more than the write
-    /// (BENCHMARK.md, "Speed", session 43).
+    /// (benches/SPEED_LOG.md, session 43).
     #[inline(always)]
     pub fn insert(&mut self, key: CellKey, value: T) {
         let (t, slot) = self.tile_of(key);
@@ -530,7 +530,7 @@ impl<'a, T, const REMEMBER: bool> Cursor<'a, T, REMEMBER> {
         // Inside its tile (36 of a tile's 64 cells), the block is 3 runs of 3
         // slots of that one tile: one tile look-up, fixed offsets. On the
         // Intel log's loop this takes the block from 313 to 250 instructions
-        // (BENCHMARK.md, "Speed", session 13).
+        // (benches/SPEED_LOG.md, session 13).
         let (sx, sy) = (key.ix & MASK, key.iy & MASK);
         if sx > 0 && sy > 0 && sx < MASK && sy < MASK {
             let (tile, slot) = split(key);

@@ -58,7 +58,7 @@ impl TileDirectory {
     pub fn get(&self, index: (i32, i32)) -> Option<u32> {
         // Off, no word is kept: inside the rectangle too, `None`. The hot
         // path keeps its own test rather than `position`'s: 0.3 % fewer
-        // instructions in `insert_case` (BENCHMARK.md, "Speed", session 44).
+        // instructions in `insert_case` (benches/SPEED_LOG.md, session 44).
         let (dx, dy) = self.offset(index);
         if dx < self.w && dy < self.h {
             self.words

@@ -35,7 +35,7 @@ impl CellWindow {
         self.history.push_back((n, touched));
         // The stale cells are kept in the leaving scan's own vector (no
         // vector grows: on a helper thread, growing one could wait for the
-        // allocator's lock, BENCHMARK.md, "Speed", session 27).
+        // allocator's lock, benches/SPEED_LOG.md, session 27).
         let mut stale = Vec::new();
         while self.history.len() > size {
             let Some((m, mut keys)) = self.history.pop_front() else {

@@ -207,7 +207,7 @@ const COUNTED: usize = 4;
 /// `before` holds below some `k` and fails from there on). Crossing a block
 /// of 32 cells on a slope near 1 then costs a few comparisons instead of
 /// 32. Estimating from the first crossing (with a division) cost
-/// criterion's `odometry_step/181_beams_2cm` 4 % (BENCHMARK.md, "Speed",
+/// criterion's `odometry_step/181_beams_2cm` 4 % (benches/SPEED_LOG.md,
 /// session 25).
 #[inline]
 fn first_not(

@@ -5,7 +5,7 @@
 //! reads of the later ones: the probe remembers them by block index modulo
 //! 32 ([`crate::cellmask::CellMask::window_reader`]). Kept across the beams
 //! with that memo, the odometry helper's instructions fell by 8 %
-//! (BENCHMARK.md, "Speed", session 25).
+//! (benches/SPEED_LOG.md, session 25).
 
 use nalgebra::Vector2;
 

@@ -9,7 +9,7 @@
 //! a change to the grid; its helper thread takes 8 scans at a time
 //! ([`crate::mapworker`]). A coarse cell above several of those changes is
 //! re-summed once instead of after each: on the first 3000 Intel scans the
-//! helper's instructions fell by 13 % (BENCHMARK.md, "Speed", session 19).
+//! helper's instructions fell by 13 % (benches/SPEED_LOG.md, session 19).
 //! The result is the same bit for bit: a coarse cell is a function of the
 //! fine cells below it ([`crate::pyramid`]), a kept distribution one of the
 //! sums ([`crate::distributions`]).

@@ -8,8 +8,8 @@
 //! and each coarser cell above them, with the prepared distributions of
 //! every level, is brought up to date once at the end, however many scans
 //! of the batch changed it. Consecutive scans of a log see mostly the same
-//! surfaces, so that upkeep, most of a single insert's work (BENCHMARK.md,
-//! "Speed", session 36: the re-sums and distributions are 80 % of an
+//! surfaces, so that upkeep, most of a single insert's work (benches/SPEED_LOG.md,
+//! session 36: the re-sums and distributions are 80 % of an
 //! insert's instructions), is shared by the batch. The grid that results is
 //! the one the inserts one by one give, bit for bit (a coarse cell is a
 //! function of the fine cells, a distribution one of the sums).

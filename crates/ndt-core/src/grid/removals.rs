@@ -4,7 +4,7 @@
 //! cells that left the grid by other means than its own deletions (the
 //! odometry loop's map window, a caller's [`NdtGrid::remove_cells`]). Asking
 //! the grid about every record at every periodic check was about 14 % of the
-//! odometry helper's instructions (BENCHMARK.md, "Speed", session 24). With
+//! odometry helper's instructions (benches/SPEED_LOG.md, session 24). With
 //! this count the filter tells "the grid lost only the cells I know of" from
 //! "something else removed cells": equal stamps of one grid mean no cell left
 //! it in between ([`crate::mapper::MapFilter::run_checks`]).

@@ -160,7 +160,7 @@ impl MapFilter {
             }
         }
         // Vectors sized at once (here and below): each growth of a vector
-        // would take the allocator's lock (BENCHMARK.md, "Speed", session
+        // would take the allocator's lock (benches/SPEED_LOG.md, session
         // 27).
         let mut hit: Vec<CellKey> = Vec::with_capacity(n);
         hit.extend(

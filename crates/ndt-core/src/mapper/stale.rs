@@ -7,7 +7,7 @@
 //! ([`crate::mapper::MapFilter`] works on a grid its caller keeps, e.g. the
 //! Python binding's shared one). Each periodic check forgets the records whose cells
 //! are gone. Asking the grid about every record there cost about 14 % of the
-//! odometry helper's instructions (BENCHMARK.md, "Speed", session 24); this
+//! odometry helper's instructions (benches/SPEED_LOG.md, session 24); this
 //! remembers the keys the mapper removed and the grid's removal count
 //! ([`NdtGrid::removal_stamp`]), so that a check asks about those keys only
 //! when no other cell left the grid, and about every record otherwise. The

@@ -1,0 +1,87 @@
+"""``benches/SPEED_LOG.md``, issue 7's sessions one section each, and what points into it.
+
+The code, the docs and the benches cite the log as "benches/SPEED_LOG.md, session N"; a
+citation of a session the log has no section for, a session out of order, a link that
+does not resolve, or BENCHMARK.md naming a different last session fails here.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+LOG = ROOT / "benches" / "SPEED_LOG.md"
+
+# "## Session 59 (…" or "## Sessions 22\u201323 (…" (an en dash, \u2013)
+HEADING = re.compile(r"^## Sessions? (\d+)(?:\u2013(\d+))?\b", re.MULTILINE)
+# "benches/SPEED_LOG.md, session 28", "``benches/SPEED_LOG.md``, sessions 29 and\n33",
+# a comment's prefix allowed where the citation wraps
+CITATION = re.compile(
+    r"SPEED_LOG\.md`*,\s*(?:(?://[/!]?|#)\s*)?sessions?\s+"
+    r"(\d+(?:\s*(?:(?://[/!]?|#)\s*)?(?:,|and|\u2013|-)\s*(?:(?://[/!]?|#)\s*)?\d+)*)"
+)
+SUFFIXES = {".py", ".pyi", ".rs", ".md", ".toml"}
+SKIP_DIRS = {"target", "__pycache__", "node_modules"}
+
+
+def sessions() -> list[tuple[int, int]]:
+    """Each section's sessions, first and last, in the log's order."""
+    return [
+        (int(m[1]), int(m[2] or m[1])) for m in HEADING.finditer(LOG.read_text(encoding="utf-8"))
+    ]
+
+
+def sources() -> list[Path]:
+    """The repository's text files that may cite the log (build output and hidden or
+    virtual-environment directories left out)."""
+    found = []
+    for top, dirs, files in os.walk(ROOT):
+        dirs[:] = [
+            d
+            for d in dirs
+            if d not in SKIP_DIRS
+            and not d.startswith(".")
+            and not (Path(top) / d / "pyvenv.cfg").exists()
+        ]
+        found += [Path(top) / f for f in files if Path(f).suffix in SUFFIXES]
+    return found
+
+
+def test_sections_run_newest_first_without_gaps() -> None:
+    spans = sessions()
+    assert spans[0][0] >= 59, spans[0]
+    # the oldest section is session 5's, which also has sessions 3 and 4's figures
+    assert spans[-1] == (5, 5)
+    for (first, _), (_, last) in zip(spans, spans[1:]):
+        assert last == first - 1, (first, last)
+
+
+def test_every_citation_names_a_session_of_the_log() -> None:
+    known = {n for first, last in sessions() for n in range(first, last + 1)}
+    cited = 0
+    for path in sources():
+        text = path.read_text(encoding="utf-8", errors="replace")
+        for m in CITATION.finditer(text):
+            numbers = [int(n) for n in re.findall(r"\d+", m[1])]
+            missing = [n for n in numbers if n not in known]
+            assert not missing, f"{path.relative_to(ROOT)}: {m[0]!r} cites {missing}"
+            cited += 1
+    # the core's comments, the package's docstrings and the benches cite it dozens of times
+    assert cited >= 60, cited
+
+
+def test_no_session_section_left_in_benchmark() -> None:
+    text = (ROOT / "BENCHMARK.md").read_text(encoding="utf-8")
+    assert not re.search(r"^#+ Sessions? \d", text, re.MULTILINE)
+    newest = sessions()[0][1]
+    assert f"What\neach session from 3 to {newest} measured is in the speed log" in text
+
+
+def test_the_logs_links_resolve() -> None:
+    text = LOG.read_text(encoding="utf-8")
+    links = re.findall(r"\]\(([^)\s]+)\)", text)
+    assert links
+    for link in links:
+        assert (LOG.parent / link.split("#")[0]).exists(), link
