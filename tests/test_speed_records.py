@@ -192,10 +192,6 @@ def column(runs: list[Any], key: str) -> list[Any]:
     return [r.cells[i] for r in runs]
 
 
-def span(values: list[float], digits: int) -> str:
-    return f"{min(values):.{digits}f}{DASH}{max(values):.{digits}f}"
-
-
 def test_benchmark_short_reasons_quote_the_runs(runs: list[Any], totals: dict[str, Any]) -> None:
     """The short "Why the misses stay" and the status cells BENCHMARK.md words from the
     runs: their counts, and the misses' ranges worked out run by run."""
@@ -247,9 +243,9 @@ def test_benchmark_short_reasons_quote_the_runs(runs: list[Any], totals: dict[st
         f"Over the {n} runs our loop took {totals['intel'].spans[0]} s and KISS-ICP "
         f"{totals['odometry_peer'].spans[1]} s" in why
     )
-    ratio = span([ratios[i].parts[0].value for i in missed], 2)
-    loop = span([loops[i].parts[0].value for i in missed], 2)
-    kiss = span([ratios[i].parts[1].value for i in missed], 2)
+    ratio = sr._span([ratios[i].parts[0] for i in missed])
+    loop = sr._span([loops[i].parts[0] for i in missed])
+    kiss = sr._span([ratios[i].parts[1] for i in missed])
     assert (
         f"its {len(missed)} misses ({ratio}{TIMES}) came with our loop at {loop} s and "
         f"KISS-ICP at {kiss} s" in why
@@ -264,7 +260,7 @@ def test_benchmark_short_reasons_quote_the_runs(runs: list[Any], totals: dict[st
     slow = [i for i, c in enumerate(matches) if c.met() is False]
     # every miss on the model-207 VM so far was the URG scans of >= 500 points alone
     assert all(p.met() is not False for i in slow for p in matches[i].parts[:2])
-    urg = span([matches[i].parts[2].value for i in slow], 3)
+    urg = sr._span([matches[i].parts[2] for i in slow])
     least = f"{min(inserts[i] for i in slow):.1f}"
     assert f"Its {len(slow)} misses on the model-207 VM ({urg} ms" in why
     assert f"the insert took {least} µs or more" in why
