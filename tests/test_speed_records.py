@@ -80,6 +80,17 @@ def totals(runs: list[Any]) -> dict[str, Any]:
     return {t.row.key: t for t in sr.totals(runs)}
 
 
+@pytest.fixture(scope="module")
+def rounds(runs: list[Any]) -> tuple[int, int]:
+    """The rounds whose two threads began on one vCPU, and the rounds whose vCPUs were
+    read, over every run."""
+    threads = [r.sections["threads"] for r in runs]
+    return (
+        sum(t["one_cpu_first_runs"] for t in threads),
+        sum(t["cpu_read_runs"] for t in threads),
+    )
+
+
 def flat(text: str) -> str:
     """``text`` with each run of white space one space, as a reader sees it."""
     return " ".join(text.split())
@@ -156,7 +167,9 @@ def test_the_runs_are_whole_runs_of_one_machine(runs: list[Any]) -> None:
     assert len({r.name for r in runs}) == len(runs)
 
 
-def test_readme_quotes_the_runs(runs: list[Any], totals: dict[str, Any]) -> None:
+def test_readme_quotes_the_runs(
+    runs: list[Any], totals: dict[str, Any], rounds: tuple[int, int]
+) -> None:
     text = (ROOT / "README.md").read_text()
     n, first, last = len(runs), runs[0].name, runs[-1].name
     intro = text[text.index("### Issue 7's targets, against the peers") :]
@@ -167,10 +180,7 @@ def test_readme_quotes_the_runs(runs: list[Any], totals: dict[str, Any]) -> None
     threads = table(text, "| two threads … |")
     assert f"{n} runs)" in threads[0][1]
     check(threads, [1], README_THREADS, totals)
-    # the rounds whose two threads began on one vCPU, over every run's rounds
-    rounds = [r.sections["threads"] for r in runs]
-    together = sum(t["one_cpu_first_runs"] for t in rounds)
-    read = sum(t["cpu_read_runs"] for t in rounds)
+    together, read = rounds
     assert f"on the first one's vCPU in {together} of {read} rounds" in flat(text)
 
 
@@ -192,22 +202,27 @@ def column(runs: list[Any], key: str) -> list[Any]:
     return [r.cells[i] for r in runs]
 
 
-def test_benchmark_short_reasons_quote_the_runs(runs: list[Any], totals: dict[str, Any]) -> None:
+def test_benchmark_short_reasons_quote_the_runs(
+    runs: list[Any], totals: dict[str, Any], rounds: tuple[int, int]
+) -> None:
     """The short "Why the misses stay" and the status cells BENCHMARK.md words from the
     runs: their counts, and the misses' ranges worked out run by run."""
-    text = flat((ROOT / "BENCHMARK.md").read_text())
+    raw = (ROOT / "BENCHMARK.md").read_text()
+    text = flat(raw)
     start = text.index("Why the misses stay, in short")
     why = text[start : text.index("### How this section is laid out", start)]
-    rows = table((ROOT / "BENCHMARK.md").read_text(), "| target (issue 7) | judged by |")
-    status = {r[0]: flat(r[-1]) for r in rows[1:]}
+    rows = table(raw, "| target (issue 7) | judged by |")
     n = len(runs)
+
+    def status(target: str) -> str:
+        """The status cell of the one row whose target starts with ``target``."""
+        (cell,) = [flat(r[-1]) for r in rows[1:] if r[0].startswith(target)]
+        return cell
 
     def count(key: str) -> str:
         return "{} of {}".format(*totals[key].count)
 
-    threads = [r.sections["threads"] for r in runs]
-    together = sum(t["one_cpu_first_runs"] for t in threads)
-    read = sum(t["cpu_read_runs"] for t in threads)
+    together, read = rounds
     pinned, many = totals["pinned"].count, totals["many"].count
     assert pinned[1] == many[1] == n, (pinned, many)
     for quote in (
@@ -217,7 +232,7 @@ def test_benchmark_short_reasons_quote_the_runs(runs: list[Any], totals: dict[st
         f"met it in {pinned[0]} and {many[0]} of {n}",
     ):
         assert quote in why, quote
-    (thread_status,) = [s for name, s in status.items() if name.startswith("two Python")]
+    thread_status = status("two Python")
     for quote in (
         f"in {count('threads')} runs",
         f"in {together} of {read} rounds",
@@ -233,8 +248,7 @@ def test_benchmark_short_reasons_quote_the_runs(runs: list[Any], totals: dict[st
         in why
     )
     assert f"the {n} runs, a median of {median} µs" in why
-    (insert_status,) = [s for name, s in status.items() if name.startswith("insert of")]
-    assert f"in {count('insert')} runs on the model-207 VM" in insert_status
+    assert f"in {count('insert')} runs on the model-207 VM" in status("insert of")
 
     loops = column(runs, "intel")
     ratios = column(runs, "odometry_peer")
@@ -250,10 +264,9 @@ def test_benchmark_short_reasons_quote_the_runs(runs: list[Any], totals: dict[st
         f"its {len(missed)} misses ({ratio}{TIMES}) came with our loop at {loop} s and "
         f"KISS-ICP at {kiss} s" in why
     )
-    (kiss_status,) = [s for name, s in status.items() if name.startswith("… and")]
     assert (
         f"({count('odometry_peer')}; the {len(missed)} misses {ratio}{TIMES}, with our loop "
-        f"at {loop} s)" in kiss_status
+        f"at {loop} s)" in status("… and")
     )
 
     matches = column(runs, "match")
