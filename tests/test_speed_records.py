@@ -213,6 +213,7 @@ def test_benchmark_status_table_quotes_the_runs(runs: list[Any], totals: dict[st
     check(rows, [2, 3], BENCHMARK_STATUS, totals)
     prose = flat(text)
     assert f"(runs {first}{DASH}{last}, {n} runs on Intel" in prose
+    assert f"The {n} runs are kept in `benches/runs/`" in prose
     assert f"Each target's numbers in the {n} runs" in prose
     assert f"![Issue 7's targets in runs {first}{DASH}{last} of benches/speed.py]" in text
 
