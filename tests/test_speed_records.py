@@ -301,6 +301,8 @@ def test_benchmark_short_reasons_quote_the_runs(
         in why
     )
     assert f"the {n} runs, a median of {median} µs" in why
+    (insert_row,) = [r for r in rows[1:] if r[0].startswith("insert of")]
+    assert f"{totals['insert'].spans[0]} µs (a median of {median} µs;" in insert_row[2]
     assert f"in {count('insert')} runs on the model-207 VM" in status("insert of")
 
     loops = column(runs, "intel")
