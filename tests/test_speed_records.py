@@ -240,6 +240,7 @@ def missed(runs: list[Any], key: str) -> list[int]:
 
 def listed(names: list[str]) -> str:
     """``names`` as prose lists them: "a, b and c"."""
+    assert names, "no run to list"
     return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
 
 
@@ -248,6 +249,7 @@ def bundles_fell(runs: list[Any]) -> str:
     how many of those fell below 1.6 times too, and their range."""
     pinned = missed(runs, "pinned")
     low = [b for i in pinned if (b := runs[i].sections["threads"]["bundle_ratio"]) < 1.6]
+    assert low, "no run whose pinned workers and GIL-free bundles both fell"
     return (
         f"in {len(low)} of the {len(pinned)} runs whose pinned workers missed, the GIL-free "
         f"bundles (no Python, no GIL) fell below 1.6{TIMES} too "
@@ -275,12 +277,11 @@ def test_benchmark_short_reasons_quote_the_runs(
     def count(key: str) -> str:
         return "{} of {}".format(*totals[key].count)
 
-    together, read = rounds.together, rounds.read
     pinned, many = totals["pinned"].count, totals["many"].count
     assert pinned[1] == many[1] == n, (pinned, many)
     for quote in (
         f"met 1.7{TIMES} in {totals['threads'].count[0]} of the {n} runs",
-        f"in {together} of their {read} rounds",
+        f"in {rounds.together} of their {rounds.read} rounds",
         f"met it in {count('steady')} runs",
         f"met it in {pinned[0]} and {many[0]} of {n}",
     ):
@@ -288,7 +289,7 @@ def test_benchmark_short_reasons_quote_the_runs(
     thread_status = status("two Python")
     for quote in (
         f"in {count('threads')} runs",
-        f"in {together} of {read} rounds",
+        f"in {rounds.together} of {rounds.read} rounds",
         f"in {count('steady')}, two pinned workers in {count('pinned')}",
         f"call in {count('many')}",
     ):
