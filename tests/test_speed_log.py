@@ -11,8 +11,10 @@ import os
 import re
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-LOG = ROOT / "benches" / "SPEED_LOG.md"
+from tests._benches import BENCHES
+
+ROOT = BENCHES.parent
+LOG = BENCHES / "SPEED_LOG.md"
 
 # "## Session 59 (…" or "## Sessions 22\u201323 (…" (an en dash, \u2013)
 HEADING = re.compile(r"^## Sessions? (\d+)(?:\u2013(\d+))?\b", re.MULTILINE)
