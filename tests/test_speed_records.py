@@ -7,8 +7,10 @@ its counts of runs that met the target, and name the runs' number and first and 
 run. BENCHMARK.md's short "Why the misses stay" and its status cells of the match, the
 insert, the odometry ratio and the threads must quote the counts and the misses' ranges
 the runs give, and the README the rounds whose two threads began on one vCPU, with their
-median ratio and the others'. A new run added without the docs brought up to date fails
-here, as does a doc number copied wrong.
+median ratio and the others'. Every table of ``benches/SPEED_LOG.md`` that prints kept
+runs must be what ``speed_runs.py`` prints of them, and every kept run must be printed
+there. A new run added without the docs brought up to date fails here, as does a doc
+number copied wrong.
 """
 
 from __future__ import annotations
@@ -340,6 +342,60 @@ def test_benchmark_short_reasons_quote_the_runs(
         f"{simulated} ms in the same runs) and run 142 on the Zen 4" in status("median match")
     )
     assert f"the insert took {least} µs or more" in why
+
+
+def log_tables(lines: list[str]) -> list[tuple[int, list[str], bool]]:
+    """The speed log's tables of runs (a header ``| target | …``), each with the index
+    of its first line and its lines, and whether a section heading came before it since
+    the table before (a section's batches do not run on into the next section's)."""
+    found: list[tuple[int, list[str], bool]] = []
+    i, heading = 0, True
+    while i < len(lines):
+        if lines[i].startswith("## "):
+            heading = True
+        if not lines[i].startswith("| target |"):
+            i += 1
+            continue
+        end = i
+        while end < len(lines) and lines[end].startswith("|"):
+            end += 1
+        found.append((i, lines[i:end], heading))
+        i, heading = end, False
+    return found
+
+
+def test_the_speed_log_prints_the_kept_runs_as_speed_runs_does(runs: list[Any]) -> None:
+    """Each of the log's per-run tables whose runs are kept is ``speed_runs``' table of
+    them, and each summary table (``| target | 16 runs | met |``) and the line under it
+    are ``speed_runs``' summary of the per-run tables above it in its section, since the
+    summary before; every kept run is in one of those tables."""
+    by_name = {r.name: r for r in runs}
+    lines = (BENCHES / "SPEED_LOG.md").read_text(encoding="utf-8").splitlines()
+    printed: list[str] = []
+    batch: list[str] = []
+    for start, rows, new_section in log_tables(lines):
+        if new_section:
+            batch = []
+        names = cells(rows[0])[1:-1]
+        where = f"benches/SPEED_LOG.md line {start + 1}"
+        if len(names) == 1 and names[0].endswith(" runs"):
+            group, batch = batch, []
+            if not group or any(n not in by_name for n in group):
+                continue
+            assert names[0] == f"{len(group)} runs", f"{where}: the batch above has {len(group)}"
+            want = sr.summary([by_name[n] for n in group])
+            got = lines[start : start + len(want)]
+        else:
+            batch += names
+            if any(n not in by_name for n in names):
+                continue
+            want = sr.run_tables([by_name[n] for n in names], len(names))
+            got = rows
+            printed += names
+        for k, (a, b) in enumerate(zip(got, want)):
+            assert a == b, f"{where} + {k}: {a!r}, the runs print {b!r}"
+        assert len(got) == len(want), f"{where}: {len(got)} lines, the runs print {len(want)}"
+    assert sorted(printed, key=int) == sorted(by_name, key=int), "a run printed twice or not at all"
 
 
 @pytest.mark.parametrize(
