@@ -8,10 +8,18 @@ the other groups one line each, and the targets of issue 7 that criterion times 
 the one criterion's ``time:`` line shows: the slope of its linear fit where it made one,
 else the mean.
 
+``--save PATH`` also writes the estimates it read to ``PATH`` (JSON: the machine and
+commit, where and when they were written, each benchmark's time [s]), and ``--from
+PATH`` prints the table again from such a file; a session's file is kept in
+``benches/criterion/``, and the tests check that its table is the one its section of
+``benches/SPEED_LOG.md`` shows.
+
 Run from the repository root after ``cargo bench``::
 
     python benches/criterion_table.py
     python benches/criterion_table.py --dir other/target/criterion
+    python benches/criterion_table.py --save benches/criterion/session63.json
+    python benches/criterion_table.py --from benches/criterion/session63.json
 """
 
 from __future__ import annotations
@@ -21,6 +29,7 @@ import json
 import sys
 import time
 from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -92,6 +101,74 @@ def results(root: Path) -> list[Path]:
     return sorted(root.rglob("new/estimates.json")) if root.is_dir() else []
 
 
+@dataclass(frozen=True)
+class Estimates:
+    """Criterion's times [s] by benchmark (``group/function/value``), where they were
+    read from, and when the newest of them was written (``YYYY-MM-DD HH:MM``)."""
+
+    times: dict[str, float]
+    source: str
+    written: str
+
+
+def read(root: Path) -> Estimates:
+    """Every benchmark's time under ``root`` (see :func:`estimate`).
+
+    Raises
+    ------
+    FileNotFoundError
+        ``root`` holds no criterion results.
+    ValueError
+        An estimates file is not JSON or holds neither estimate.
+    """
+    files = results(root)
+    if not files:
+        raise FileNotFoundError(f"no criterion results in {root}: run `cargo bench` first")
+    newest = time.localtime(max(f.stat().st_mtime for f in files))
+    times: dict[str, float] = {}
+    for f in files:
+        bench = f.parent.parent.relative_to(root).as_posix()
+        seconds = estimate(root, bench)
+        if seconds is not None:
+            times[bench] = seconds
+    return Estimates(times, str(root), time.strftime("%Y-%m-%d %H:%M", newest))
+
+
+def save(est: Estimates, machine: str, path: Path) -> None:
+    """``est`` and the ``machine`` line as ``--save``'s JSON at ``path``, whole or not
+    at all (:func:`datasets.write_whole`)."""
+    doc = {"machine": machine, "source": est.source, "written": est.written, "times": est.times}
+    datasets.write_whole(path, json.dumps(doc, indent=1, sort_keys=True) + "\n")
+
+
+def load(path: Path) -> tuple[Estimates, str]:
+    """A file :func:`save` wrote: its estimates and its machine line.
+
+    Raises
+    ------
+    ValueError
+        ``path`` is not such a file (not JSON, a field missing, a time not a number).
+    OSError
+        ``path`` cannot be read.
+    """
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{path}: not JSON ({e})") from e
+    fields = ("machine", "source", "written", "times")
+    if not isinstance(doc, dict) or any(k not in doc for k in fields):
+        raise ValueError(f"{path}: not a file of --save (it needs {', '.join(fields)})")
+    times = doc["times"]
+    if not isinstance(times, dict) or not all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) for v in times.values()
+    ):
+        raise ValueError(f"{path}: its times are not numbers by benchmark")
+    est = Estimates(
+        {str(k): float(v) for k, v in times.items()}, str(doc["source"]), str(doc["written"])
+    )
+    return est, str(doc["machine"])
+
+
 def _unit(seconds: float) -> str:
     """BENCHMARK.md's unit for a time: µs below 1 ms, else ms."""
     return "µs" if seconds < 1e-3 else "ms"
@@ -132,20 +209,15 @@ def table(root: Path) -> list[str]:
     ValueError
         An estimates file is not JSON or holds neither estimate.
     """
-    files = results(root)
-    if not files:
-        raise FileNotFoundError(f"no criterion results in {root}: run `cargo bench` first")
-    newest = time.localtime(max(f.stat().st_mtime for f in files))
-    est: dict[str, float | None] = {}
+    return lines_of(read(root))
 
-    def t(bench: str) -> float | None:
-        if bench not in est:
-            est[bench] = estimate(root, bench)
-        return est[bench]
 
+def lines_of(est: Estimates) -> list[str]:
+    """The Markdown lines for ``est`` (see the module docs)."""
+    t = est.times.get
     head = " | ".join(f"{label}: {' / '.join(map(str, BEAMS))} points" for label in CELLS.values())
     lines = [
-        f"Results in {root}, the newest written {time.strftime('%Y-%m-%d %H:%M', newest)}.",
+        f"Results in {est.source}, the newest written {est.written}.",
         "",
         f"| group | {head} |",
         "|---|" + "---|" * len(CELLS),
@@ -195,17 +267,31 @@ def table(root: Path) -> list[str]:
 
 
 def main() -> int:
-    """Print the table for ``--dir`` (``target/criterion`` by default)."""
+    """Print the table for ``--dir`` (``target/criterion`` by default) or ``--from``, and
+    with ``--save`` keep what ``--dir`` held."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--dir", type=Path, default=datasets.REPO / "target" / "criterion")
+    where = ap.add_mutually_exclusive_group()
+    where.add_argument("--dir", type=Path, default=datasets.REPO / "target" / "criterion")
+    where.add_argument("--from", dest="kept", type=Path, metavar="PATH", help="a --save file")
+    ap.add_argument("--save", type=Path, metavar="PATH", help="also write the estimates here")
     args = ap.parse_args()
+    if args.kept is not None and args.save is not None:
+        ap.error("--save writes what --dir holds; --from reads a file --save wrote")
     try:
-        lines = table(args.dir)
-    except (FileNotFoundError, ValueError) as e:
+        if args.kept is not None:
+            est, machine = load(args.kept)
+            head = f"Machine (and the commit checked out when saved): {machine}"
+        else:
+            est = read(args.dir)
+            machine = f"{datasets.machine()}{datasets.dirty()}"
+            head = f"Machine (and the commit checked out now): {machine}"
+            if args.save is not None:
+                save(est, machine, args.save)
+    except (OSError, ValueError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    print(f"Machine (and the commit checked out now): {datasets.machine()}{datasets.dirty()}\n")
-    print("\n".join(lines))
+    print(f"{head}\n")
+    print("\n".join(lines_of(est)))
     return 0
 
 

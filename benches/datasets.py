@@ -24,6 +24,7 @@ Run from the repository root (prints progress, then a markdown table)::
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import platform
@@ -258,6 +259,21 @@ def machine() -> str:
     cpu = f"{processor_name()}, {kernels_name()}"
     commit = (git("rev-parse", "--short", "HEAD") or "unknown").strip()
     return f"{os.cpu_count()} cores of {cpu}, Python {platform.python_version()}, commit {commit}"
+
+
+def write_whole(path: Path, text: str) -> None:
+    """``text`` as the file ``path``, written to a file beside it and renamed over it,
+    so a reader never sees half a document; if the write or the rename fails (a full
+    disk, Ctrl-C), that file is removed and ``path`` keeps what it held."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".part")
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        tmp.replace(path)
+    except BaseException:
+        with contextlib.suppress(OSError):  # the first error is the one to report
+            tmp.unlink(missing_ok=True)
+        raise
 
 
 def dirty() -> str:

@@ -215,16 +215,7 @@ def write_json(
         "complete": complete,
         "sections": sections,
     }
-    text = json.dumps(json_ready(doc), indent=1, allow_nan=False) + "\n"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".part")
-    try:
-        tmp.write_text(text)
-        tmp.replace(path)
-    except BaseException:
-        with contextlib.suppress(OSError):  # the first error is the one to report
-            tmp.unlink(missing_ok=True)
-        raise
+    datasets.write_whole(path, json.dumps(json_ready(doc), indent=1, allow_nan=False) + "\n")
 
 
 def rss_kib() -> tuple[int, int]:

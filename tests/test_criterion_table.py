@@ -120,3 +120,83 @@ def test_only_an_earlier_run_is_no_results(tmp_path: Path) -> None:
     (d / "estimates.json").write_text('{"slope": {"point_estimate": 1.0}}')
     with pytest.raises(FileNotFoundError):
         ct.table(tmp_path)
+
+
+def test_a_saved_file_prints_the_same_table(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    tree = tmp_path / "criterion"
+    write(tree, "insert/cell_2cm/683", slope=51_234.0)
+    write(tree, "match/cell_2cm/683", slope=None, mean=98_600.0)
+    write(tree, "match_many/one_thread", slope=6.5e6)
+    saved = tmp_path / "kept" / "session1.json"
+    monkeypatch.setattr(
+        sys, "argv", ["criterion_table.py", "--dir", str(tree), "--save", str(saved)]
+    )
+    assert ct.main() == 0
+    live = capsys.readouterr().out.splitlines()
+    doc = json.loads(saved.read_text())
+    assert doc["times"] == {
+        "insert/cell_2cm/683": pytest.approx(51.234e-6),
+        "match/cell_2cm/683": pytest.approx(98.6e-6),
+        "match_many/one_thread": pytest.approx(6.5e-3),
+    }
+    assert doc["source"] == str(tree)
+    assert not saved.with_name(saved.name + ".part").exists()
+    monkeypatch.setattr(sys, "argv", ["criterion_table.py", "--from", str(saved)])
+    assert ct.main() == 0
+    again = capsys.readouterr().out.splitlines()
+    # the same lines but the machine's, which says when it was read
+    assert live[0].startswith("Machine (and the commit checked out now): ")
+    assert again[0] == live[0].replace("checked out now", "checked out when saved")
+    assert again[1:] == live[1:]
+    assert "| insert of a 683-point scan ≤ 50 µs (into a fresh clone) " in "\n".join(again)
+    assert ct.lines_of(ct.load(saved)[0]) == ct.table(tree)
+
+
+@pytest.mark.parametrize(
+    ("text", "why"),
+    [
+        ("{", "not JSON ("),
+        ('{"machine": "m", "source": "s", "times": {}}', "not a file of --save "),
+        ("[1, 2]", "not a file of --save "),
+        (
+            '{"machine": "m", "source": "s", "written": "w", "times": {"a/b": "1"}}',
+            "its times are not numbers by benchmark",
+        ),
+        (
+            '{"machine": "m", "source": "s", "written": "w", "times": {"a/b": true}}',
+            "its times are not numbers by benchmark",
+        ),
+    ],
+)
+def test_a_file_not_saved_here_is_named(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    text: str,
+    why: str,
+) -> None:
+    path = tmp_path / "kept.json"
+    path.write_text(text)
+    with pytest.raises(ValueError) as e:
+        ct.load(path)
+    assert str(e.value).startswith(f"{path}: {why}")
+    monkeypatch.setattr(sys, "argv", ["criterion_table.py", "--from", str(path)])
+    assert ct.main() == 2
+    assert capsys.readouterr().err.startswith(f"error: {path}: {why}")
+
+
+def test_save_and_from_together_are_refused(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.setattr(
+        sys, "argv", ["criterion_table.py", "--from", "a.json", "--save", str(tmp_path / "b")]
+    )
+    with pytest.raises(SystemExit) as e:
+        ct.main()
+    assert e.value.code == 2
+    assert "--save writes what --dir holds; --from reads a file --save wrote" in (
+        capsys.readouterr().err
+    )
+    assert not (tmp_path / "b").exists()
