@@ -2,7 +2,9 @@
 
 The code, the docs and the benches cite the log as "benches/SPEED_LOG.md, session N"; a
 citation of a session the log has no section for, a session out of order, a link that
-does not resolve, or BENCHMARK.md naming a different last session fails here.
+does not resolve, or BENCHMARK.md naming a different last session fails here; so does
+a session whose criterion results are kept (``benches/criterion/sessionN.json``) without
+their table, as ``benches/criterion_table.py --from`` prints it, in its section.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ import os
 import re
 from pathlib import Path
 
-from tests._benches import BENCHES
+from tests._benches import BENCHES, load_bench
 
 ROOT = BENCHES.parent
 LOG = BENCHES / "SPEED_LOG.md"
@@ -26,6 +28,14 @@ CITATION = re.compile(
 )
 SUFFIXES = {".py", ".pyi", ".rs", ".md", ".toml"}
 SKIP_DIRS = {"target", "__pycache__", "node_modules"}
+
+
+def section(session: int) -> str:
+    """The text of the log's section of ``session`` (its heading to the next)."""
+    text = LOG.read_text(encoding="utf-8")
+    starts = [(m.start(), int(m[1])) for m in HEADING.finditer(text)] + [(len(text), 0)]
+    (body,) = [text[a:b] for (a, n), (b, _) in zip(starts, starts[1:]) if n == session]
+    return body
 
 
 def sessions() -> list[tuple[int, int]]:
@@ -87,3 +97,17 @@ def test_the_logs_links_resolve() -> None:
     assert links
     for link in links:
         assert (LOG.parent / link.split("#")[0]).exists(), link
+
+
+def test_each_kept_criterion_run_is_tabled_in_its_session() -> None:
+    ct = load_bench("criterion_table")
+    kept = sorted((BENCHES / "criterion").glob("session*.json"))
+    assert kept, "no criterion results kept in benches/criterion/"
+    for path in kept:
+        est, machine = ct.load(path)
+        assert "+ uncommitted changes" not in machine, f"{path.name}: {machine}"
+        # the table from its header on: the first line names where the file was read
+        lines = ct.lines_of(est)
+        tabled = "\n".join(lines[lines.index("") + 1 :])
+        session = int(path.stem.removeprefix("session"))
+        assert tabled in section(session), f"{path.name}: its table is not in session {session}'s"
