@@ -200,15 +200,8 @@ def _series(times: Iterable[float | None]) -> str:
 
 
 def table(root: Path) -> list[str]:
-    """The Markdown lines for the results under ``root`` (see the module docs).
-
-    Raises
-    ------
-    FileNotFoundError
-        ``root`` holds no criterion results.
-    ValueError
-        An estimates file is not JSON or holds neither estimate.
-    """
+    """The Markdown lines for the results under ``root`` (see the module docs): what
+    :func:`lines_of` prints of :func:`read`'s estimates, with :func:`read`'s errors."""
     return lines_of(read(root))
 
 
