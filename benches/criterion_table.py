@@ -72,18 +72,15 @@ TARGETS = (
 )
 
 
-def estimate(root: Path, bench: str) -> float | None:
-    """The time [s] criterion shows for ``bench`` (``group/function/value``) under
-    ``root``: its slope, else its mean; ``None`` when it has not been run.
+def estimate(path: Path) -> float:
+    """The time [s] criterion shows for the estimates file ``path``: its slope, else
+    its mean.
 
     Raises
     ------
     ValueError
-        The estimates file is there but holds neither estimate.
+        The file is not JSON or holds neither estimate.
     """
-    path = root / bench / "new" / "estimates.json"
-    if not path.is_file():
-        return None
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as e:
@@ -112,7 +109,8 @@ class Estimates:
 
 
 def read(root: Path) -> Estimates:
-    """Every benchmark's time under ``root`` (see :func:`estimate`).
+    """Every benchmark's time under ``root`` (``group/function/value``, from the
+    directory of its estimates file; see :func:`estimate`).
 
     Raises
     ------
@@ -125,12 +123,7 @@ def read(root: Path) -> Estimates:
     if not files:
         raise FileNotFoundError(f"no criterion results in {root}: run `cargo bench` first")
     newest = time.localtime(max(f.stat().st_mtime for f in files))
-    times: dict[str, float] = {}
-    for f in files:
-        bench = f.parent.parent.relative_to(root).as_posix()
-        seconds = estimate(root, bench)
-        if seconds is not None:
-            times[bench] = seconds
+    times = {f.parent.parent.relative_to(root).as_posix(): estimate(f) for f in files}
     return Estimates(times, str(root), time.strftime("%Y-%m-%d %H:%M", newest))
 
 
