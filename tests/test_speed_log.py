@@ -4,7 +4,9 @@ The code, the docs and the benches cite the log as "benches/SPEED_LOG.md, sessio
 citation of a session the log has no section for, a session out of order, a link that
 does not resolve, or BENCHMARK.md naming a different last session fails here; so does
 a session whose criterion results are kept (``benches/criterion/sessionN.json``) without
-their table, as ``benches/criterion_table.py --from`` prints it, in its section.
+their table, as ``benches/criterion_table.py --from`` prints it, in its section; and
+BENCHMARK.md's Core section not showing the newest kept table, or its history of the
+sessions' criterion tables quoting a 683-point time other than the session's own.
 """
 
 from __future__ import annotations
@@ -30,12 +32,70 @@ SUFFIXES = {".py", ".pyi", ".rs", ".md", ".toml"}
 SKIP_DIRS = {"target", "__pycache__", "node_modules"}
 
 
-def section(session: int) -> str:
-    """The text of the log's section of ``session`` (its heading to the next)."""
+def bodies() -> list[tuple[int, str]]:
+    """Each section's first session and its text (its heading to the next), in the log's
+    order."""
     text = LOG.read_text(encoding="utf-8")
     starts = [(m.start(), int(m[1])) for m in HEADING.finditer(text)] + [(len(text), 0)]
-    (body,) = [text[a:b] for (a, n), (b, _) in zip(starts, starts[1:]) if n == session]
+    return [(n, text[a:b]) for (a, n), (b, _) in zip(starts, starts[1:])]
+
+
+def section(session: int) -> str:
+    """The text of the log's section of ``session`` (its heading to the next)."""
+    (body,) = [body for n, body in bodies() if n == session]
     return body
+
+
+def core_section() -> str:
+    """BENCHMARK.md's "Core: insert and match" section, its heading to the next."""
+    text = (ROOT / "BENCHMARK.md").read_text(encoding="utf-8")
+    start = text.index("## Core: insert and match")
+    return text[start : text.index("\n## ", start)]
+
+
+def kept_tables() -> list[tuple[int, str]]:
+    """Each kept criterion file's session and its table, from its header to its targets, as
+    ``benches/criterion_table.py --from`` prints it (the first line, naming where the file
+    was read, left out), newest first."""
+    ct = load_bench("criterion_table")
+    kept = []
+    for path in (BENCHES / "criterion").glob("session*.json"):
+        est, machine = ct.load(path)
+        assert "+ uncommitted changes" not in machine, f"{path.name}: {machine}"
+        lines = ct.lines_of(est)
+        table = "\n".join(lines[lines.index("") + 1 :])
+        kept.append((int(path.stem.removeprefix("session")), table))
+    assert kept, "no criterion results kept in benches/criterion/"
+    return sorted(kept, reverse=True)
+
+
+# A full criterion table's header, as `benches/criterion_table.py` prints it; its rows
+# give the 2 cm times first ("| insert | 26.7 / 33.9 / 48.1 / 68.7 µs | …").
+GROUP_HEAD = "| group | 2 cm: 180 / 361 / 683 / 2000 points |"
+# A row of BENCHMARK.md's criterion history: session, commit, machine, criterion's times,
+# the 683-point insert and match.
+HISTORY_ROW = re.compile(
+    r"^\| (\d+) \| ([0-9a-f]{7,40}) \| [^|\n]+ \| [^|\n]+ \| ([^|\n]+) \| ([^|\n]+) \|",
+    re.MULTILINE,
+)
+
+
+def first_table_683(body: str) -> tuple[str, str] | None:
+    """The 683-point 2 cm times of the `insert` and `match` rows of ``body``'s first full
+    criterion table, each with its row's unit ("48.1 µs"); ``None`` without one."""
+    at = body.find(GROUP_HEAD)
+    if at < 0:
+        return None
+    table = body[at:].split("\n\n", 1)[0]
+    cells = []
+    for group in ("insert", "match"):
+        row = re.search(rf"^\| {group} \| ([^|\n]+) \|", table, re.MULTILINE)
+        assert row, f"no {group} row in {table[:200]!r}"
+        parts = row[1].split(" / ")
+        assert len(parts) == 4, row[0]
+        unit = parts[-1].split()[-1]
+        cells.append(parts[2] if " " in parts[2] else f"{parts[2]} {unit}")
+    return cells[0], cells[1]
 
 
 def sessions() -> list[tuple[int, int]]:
@@ -100,14 +160,23 @@ def test_the_logs_links_resolve() -> None:
 
 
 def test_each_kept_criterion_run_is_tabled_in_its_session() -> None:
-    ct = load_bench("criterion_table")
-    kept = sorted((BENCHES / "criterion").glob("session*.json"))
-    assert kept, "no criterion results kept in benches/criterion/"
-    for path in kept:
-        est, machine = ct.load(path)
-        assert "+ uncommitted changes" not in machine, f"{path.name}: {machine}"
-        # the table from its header on: the first line names where the file was read
-        lines = ct.lines_of(est)
-        tabled = "\n".join(lines[lines.index("") + 1 :])
-        session = int(path.stem.removeprefix("session"))
-        assert tabled in section(session), f"{path.name}: its table is not in session {session}'s"
+    for session, tabled in kept_tables():
+        assert tabled in section(session), f"session {session}'s table is not in its section"
+
+
+def test_benchmark_shows_the_newest_kept_criterion_table() -> None:
+    session, tabled = kept_tables()[0]
+    core = core_section()
+    assert tabled in core, f"BENCHMARK.md's Core section does not show session {session}'s table"
+    assert f"`benches/criterion/session{session}.json`" in core
+
+
+def test_the_core_history_quotes_each_sessions_criterion_table() -> None:
+    rows = HISTORY_ROW.findall(core_section())
+    tabled = [(n, cells) for n, body in bodies() if (cells := first_table_683(body))]
+    # one row for each section with a full table, newest first; the newest is the kept one
+    assert [int(r[0]) for r in rows] == [n for n, _ in tabled]
+    assert int(rows[0][0]) == kept_tables()[0][0]
+    for (session, commit, insert, match), (_, cells) in zip(rows, tabled):
+        assert commit in section(int(session)), f"session {session}: no {commit} in its section"
+        assert (insert, match) == cells, f"session {session}: {(insert, match)} against {cells}"
