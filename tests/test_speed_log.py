@@ -69,8 +69,8 @@ def kept_tables() -> list[tuple[int, str]]:
     return sorted(kept, reverse=True)
 
 
-# A full criterion table's header, as `benches/criterion_table.py` prints it; its rows
-# give the 2 cm times first ("| insert | 26.7 / 33.9 / 48.1 / 68.7 µs | …").
+# A full criterion table's header (at a line's start), as `benches/criterion_table.py`
+# prints it; its rows give the 2 cm times first ("| insert | 26.7 / 33.9 / 48.1 / 68.7 µs | …").
 GROUP_HEAD = "| group | 2 cm: 180 / 361 / 683 / 2000 points |"
 # A row of BENCHMARK.md's criterion history: session, commit, machine, criterion's times,
 # the 683-point insert and match.
@@ -83,10 +83,10 @@ HISTORY_ROW = re.compile(
 def first_table_683(body: str) -> tuple[str, str] | None:
     """The 683-point 2 cm times of the `insert` and `match` rows of ``body``'s first full
     criterion table, each with its row's unit ("48.1 µs"); ``None`` without one."""
-    at = body.find(GROUP_HEAD)
-    if at < 0:
+    head = re.search(rf"^{re.escape(GROUP_HEAD)}", body, re.MULTILINE)
+    if not head:
         return None
-    table = body[at:].split("\n\n", 1)[0]
+    table = body[head.start() :].split("\n\n", 1)[0]
     cells = []
     for group in ("insert", "match"):
         row = re.search(rf"^\| {group} \| ([^|\n]+) \|", table, re.MULTILINE)
