@@ -32,17 +32,18 @@ SUFFIXES = {".py", ".pyi", ".rs", ".md", ".toml"}
 SKIP_DIRS = {"target", "__pycache__", "node_modules"}
 
 
-def bodies() -> list[tuple[int, str]]:
-    """Each section's first session and its text (its heading to the next), in the log's
-    order."""
+def sections() -> list[tuple[int, int, str]]:
+    """Each section's sessions, first and last, and its text (its heading to the next), in
+    the log's order."""
     text = LOG.read_text(encoding="utf-8")
-    starts = [(m.start(), int(m[1])) for m in HEADING.finditer(text)] + [(len(text), 0)]
-    return [(n, text[a:b]) for (a, n), (b, _) in zip(starts, starts[1:])]
+    heads = list(HEADING.finditer(text))
+    ends = [m.start() for m in heads[1:]] + [len(text)]
+    return [(int(m[1]), int(m[2] or m[1]), text[m.start() : end]) for m, end in zip(heads, ends)]
 
 
 def section(session: int) -> str:
     """The text of the log's section of ``session`` (its heading to the next)."""
-    (body,) = [body for n, body in bodies() if n == session]
+    (body,) = [body for first, _, body in sections() if first == session]
     return body
 
 
@@ -100,9 +101,7 @@ def first_table_683(body: str) -> tuple[str, str] | None:
 
 def sessions() -> list[tuple[int, int]]:
     """Each section's sessions, first and last, in the log's order."""
-    return [
-        (int(m[1]), int(m[2] or m[1])) for m in HEADING.finditer(LOG.read_text(encoding="utf-8"))
-    ]
+    return [(first, last) for first, last, _ in sections()]
 
 
 def sources() -> list[Path]:
@@ -173,10 +172,10 @@ def test_benchmark_shows_the_newest_kept_criterion_table() -> None:
 
 def test_the_core_history_quotes_each_sessions_criterion_table() -> None:
     rows = HISTORY_ROW.findall(core_section())
-    tabled = [(n, cells) for n, body in bodies() if (cells := first_table_683(body))]
+    tabled = [(n, body, cells) for n, _, body in sections() if (cells := first_table_683(body))]
     # one row for each section with a full table, newest first; the newest is the kept one
-    assert [int(r[0]) for r in rows] == [n for n, _ in tabled]
+    assert [int(r[0]) for r in rows] == [n for n, _, _ in tabled]
     assert int(rows[0][0]) == kept_tables()[0][0]
-    for (session, commit, insert, match), (_, cells) in zip(rows, tabled):
-        assert commit in section(int(session)), f"session {session}: no {commit} in its section"
+    for (session, commit, insert, match), (_, body, cells) in zip(rows, tabled):
+        assert commit in body, f"session {session}: no {commit} in its section"
         assert (insert, match) == cells, f"session {session}: {(insert, match)} against {cells}"
