@@ -1,16 +1,18 @@
 """The speed numbers README.md and BENCHMARK.md quote over many runs agree with the runs.
 
-Every counted `benches/speed.py --json` run of the current VM is kept in `benches/runs/`;
-`benches/speed_runs.py` works each of issue 7's rows out over them (`totals`), and each
-table that quotes those rows must show its ranges (at the digits the table prints) and
-its counts of runs that met the target, and name the runs' number and first and last
-run. BENCHMARK.md's short "Why the misses stay" and its status cells of the match, the
-insert, the odometry ratio and the threads must quote the counts and the misses' ranges
-the runs give, and the README the rounds whose two threads began on one vCPU, with their
-median ratio and the others'. Every table of ``benches/SPEED_LOG.md`` that prints kept
-runs must be what ``speed_runs.py`` prints of them, and every kept run must be printed
-there. A new run added without the docs brought up to date fails here, as does a doc
-number copied wrong.
+Every counted `benches/speed.py --json` run of the model-207 VM (sessions 54 to 64) is
+kept in `benches/runs/`; `benches/speed_runs.py` works each of issue 7's rows out over
+them (`totals`), and each table that quotes those rows must show its ranges (at the
+digits the table prints) and its counts of runs that met the target, and name the runs'
+number and first and last run. BENCHMARK.md's short "Why the misses stay" and its status
+cells of the match, the insert, the odometry ratio and the threads must quote the counts
+and the misses' ranges the runs give, and the README the rounds whose two threads began
+on one vCPU, with their median ratio and the others'. Session 65's runs, on a Zen 4 VM,
+are kept apart in `benches/runs/zen4/`: BENCHMARK.md must show their summary as
+`speed_runs.py` prints it, and it and the README quote their counts. Every table of
+``benches/SPEED_LOG.md`` that prints kept runs must be what ``speed_runs.py`` prints of
+them, and every kept run must be printed there. A new run added without the docs brought
+up to date fails here, as does a doc number copied wrong.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from __future__ import annotations
 import re
 import statistics
 from decimal import Decimal
+from pathlib import Path
 from typing import Any, NamedTuple, Optional
 
 import pytest
@@ -26,9 +29,19 @@ from tests._benches import BENCHES, cells, load_bench
 
 sr = load_bench("speed_runs")
 ROOT = BENCHES.parent
-RUNS = sorted(
-    (BENCHES / "runs").glob("run*.json"), key=lambda p: int(re.sub(r"\D", "", p.stem) or 0)
-)
+
+
+def kept(folder: Path) -> list[Path]:
+    """The runs kept in ``folder``, in the order of their numbers."""
+    return sorted(folder.glob("run*.json"), key=lambda p: int(re.sub(r"\D", "", p.stem) or 0))
+
+
+RUNS = kept(BENCHES / "runs")
+# Session 65 ran on a Zen 4 VM again: its runs are kept apart from the model-207 VM's,
+# which the status table's first columns and the README's tables count.
+ZEN4 = kept(BENCHES / "runs" / "zen4")
+ZEN4_MACHINE = "2 cores of AMD EPYC (family 25, model 17, stepping 1)"
+
 DASH = "\N{EN DASH}"
 TIMES = "\N{MULTIPLICATION SIGN}"
 NUMBER = r"\d+(?:\.\d+)?"
@@ -76,6 +89,11 @@ BENCHMARK_STATUS: Quotes = {
 @pytest.fixture(scope="module")
 def runs() -> list[Any]:
     return [sr.read_run(p) for p in RUNS]
+
+
+@pytest.fixture(scope="module")
+def zen4() -> list[Any]:
+    return [sr.read_run(p) for p in ZEN4]
 
 
 @pytest.fixture(scope="module")
@@ -189,12 +207,19 @@ def test_the_runs_are_whole_runs_of_one_machine(runs: list[Any]) -> None:
     assert len({r.name for r in runs}) == len(runs)
 
 
+def test_the_zen4_runs_are_of_one_zen4_and_kept_apart(runs: list[Any], zen4: list[Any]) -> None:
+    assert zen4, "benches/runs/zen4/ holds no run"
+    assert {r.machine.split(", AVX")[0] for r in zen4} == {ZEN4_MACHINE}, sr.machines(zen4)
+    assert len({r.name for r in zen4}) == len(zen4)
+    assert not {r.name for r in zen4} & {r.name for r in runs}, "a run kept twice"
+
+
 def test_readme_quotes_the_runs(runs: list[Any], totals: dict[str, Any], rounds: Rounds) -> None:
     text = (ROOT / "README.md").read_text()
     n, first, last = len(runs), runs[0].name, runs[-1].name
     intro = text[text.index("### Issue 7's targets, against the peers") :]
     intro = flat(intro[: intro.index("| target (issue 7) |")])
-    assert f"The {n} runs on this project's current VM" in intro
+    assert f"The {n} runs on the model-207 VM" in intro
     assert f"runs {first}{DASH}{last}" in intro
     check(table(text, "| target (issue 7) |"), [1, 2], README_TARGETS, totals)
     threads = table(text, "| two threads … |")
@@ -364,12 +389,53 @@ def log_tables(lines: list[str]) -> list[tuple[int, list[str], bool]]:
     return found
 
 
-def test_the_speed_log_prints_the_kept_runs_as_speed_runs_does(runs: list[Any]) -> None:
+def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
+    """BENCHMARK.md shows ``speed_runs``' summary of the Zen 4 runs as it prints it,
+    names them, and quotes their counts in the status cells of the targets not met
+    everywhere; the README quotes the same counts."""
+    z = {t.row.key: t for t in sr.totals(zen4)}
+    n, first, last = len(zen4), zen4[0].name, zen4[-1].name
+    every = [r.name for r in zen4 if sr.met_every_target(r.cells)]
+
+    def count(key: str) -> str:
+        return "{} of {}".format(*z[key].count)
+
+    raw = (ROOT / "BENCHMARK.md").read_text()
+    lines = raw.splitlines()
+    want = sr.summary(zen4)
+    assert want[0] in lines, f"BENCHMARK.md shows no {want[0]!r}"
+    start = lines.index(want[0])
+    assert lines[start : start + len(want)] == want, "not speed_runs' summary of the Zen 4 runs"
+    text = flat(raw)
+    assert f"session 65 (runs {first}{DASH}{last}, {n} runs on a Zen 4 VM" in text
+    rows = table(raw, "| target (issue 7) | judged by |")
+    for target, key in (
+        ("median match", "match"),
+        ("insert of", "insert"),
+        ("… and", "odometry_peer"),
+        ("two Python", "threads"),
+    ):
+        (cell,) = [flat(r[-1]) for r in rows[1:] if r[0].startswith(target)]
+        assert f"On the Zen 4 VM of session 65: {count(key)} runs" in cell, (target, cell)
+
+    readme = flat((ROOT / "README.md").read_text())
+    assert f"its {n} runs ({first}{DASH}{last}), kept apart in `benches/runs/zen4/`" in readme
+    assert (
+        f"met the match in {count('match')}, the insert in {count('insert')} "
+        f"({z['insert'].spans[0]} µs), ≥ 3{TIMES} KISS-ICP in {count('odometry_peer')} and "
+        f"two threads started for each run in {count('threads')}; every target in "
+        f"{len(every)} of {n}" in readme
+    )
+
+
+def test_the_speed_log_prints_the_kept_runs_as_speed_runs_does(
+    runs: list[Any], zen4: list[Any]
+) -> None:
     """Each of the log's per-run tables whose runs are kept is ``speed_runs``' table of
     them, and each summary table (``| target | 16 runs | met |``) and the line under it
     are ``speed_runs``' summary of the per-run tables above it in its section, since the
     summary before; every kept run is in one of those tables."""
-    by_name = {r.name: r for r in runs}
+    by_name = {r.name: r for r in [*runs, *zen4]}
     lines = (BENCHES / "SPEED_LOG.md").read_text(encoding="utf-8").splitlines()
     printed: list[str] = []
     batch: list[str] = []
