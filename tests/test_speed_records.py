@@ -396,8 +396,9 @@ def log_tables(lines: list[str]) -> list[tuple[int, list[str], bool]]:
 
 def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
     """BENCHMARK.md shows ``speed_runs``' summary of the Zen 4 runs as it prints it,
-    names them, and quotes their counts in the status cells of the targets not met
-    everywhere; the README quotes the same counts."""
+    names them, quotes their insert's count and range and their rounds whose second
+    thread began on the first one's vCPU, and their counts in the status cells of the
+    targets not met everywhere; the README quotes the same counts."""
     z = {t.row.key: t for t in sr.totals(zen4)}
     n, first, last = len(zen4), zen4[0].name, zen4[-1].name
     every = [r.name for r in zen4 if sr.met_every_target(r.cells)]
@@ -413,6 +414,7 @@ def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
     assert lines[start : start + len(want)] == want, "not speed_runs' summary of the Zen 4 runs"
     text = flat(raw)
     assert f"session 65 (runs {first}{DASH}{last}, {n} runs on a Zen 4 VM" in text
+    assert f"met the insert in {count('insert')} runs ({z['insert'].spans[0]} µs;" in text
     r = rounds_of(zen4)
     assert (
         f"the second thread began on the first one's vCPU in {r.together} of its {r.read} "
