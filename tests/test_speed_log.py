@@ -11,6 +11,7 @@ sessions' criterion tables quoting a 683-point time other than the session's own
 
 from __future__ import annotations
 
+import functools
 import os
 import re
 from pathlib import Path
@@ -32,6 +33,7 @@ SUFFIXES = {".py", ".pyi", ".rs", ".md", ".toml"}
 SKIP_DIRS = {"target", "__pycache__", "node_modules"}
 
 
+@functools.cache
 def sections() -> list[tuple[int, int, str]]:
     """Each section's sessions, first and last, and its text (its heading to the next), in
     the log's order."""
@@ -54,6 +56,7 @@ def core_section() -> str:
     return text[start : text.index("\n## ", start)]
 
 
+@functools.cache
 def kept_tables() -> list[tuple[int, str]]:
     """Each kept criterion file's session and its table, from its header to its targets, as
     ``benches/criterion_table.py --from`` prints it (the first line, naming where the file

@@ -96,9 +96,19 @@ def zen4() -> list[Any]:
     return [sr.read_run(p) for p in ZEN4]
 
 
+def totals_of(runs: list[Any]) -> dict[str, Any]:
+    """``speed_runs``' total of each row over ``runs``, by the row's key."""
+    return {t.row.key: t for t in sr.totals(runs)}
+
+
+def counted(totals: dict[str, Any], key: str) -> str:
+    """How many runs met the row ``key``, as the docs quote it: "N of M"."""
+    return "{} of {}".format(*totals[key].count)
+
+
 @pytest.fixture(scope="module")
 def totals(runs: list[Any]) -> dict[str, Any]:
-    return {t.row.key: t for t in sr.totals(runs)}
+    return totals_of(runs)
 
 
 class Rounds(NamedTuple):
@@ -205,6 +215,13 @@ def check(
     assert sorted(seen) == sorted(quotes), "a row the test names is missing from the table"
 
 
+def status_cell(rows: list[list[str]], target: str) -> str:
+    """The status cell (flattened) of the one row of ``rows`` whose target starts with
+    ``target``."""
+    (cell,) = [flat(r[-1]) for r in rows[1:] if r[0].startswith(target)]
+    return cell
+
+
 def test_the_runs_are_whole_runs_of_one_machine(runs: list[Any]) -> None:
     # read_run has raised on a run that stopped part-way
     assert runs, "benches/runs/ holds no run"
@@ -302,12 +319,10 @@ def test_benchmark_short_reasons_quote_the_runs(
     n = len(runs)
 
     def status(target: str) -> str:
-        """The status cell of the one row whose target starts with ``target``."""
-        (cell,) = [flat(r[-1]) for r in rows[1:] if r[0].startswith(target)]
-        return cell
+        return status_cell(rows, target)
 
     def count(key: str) -> str:
-        return "{} of {}".format(*totals[key].count)
+        return counted(totals, key)
 
     pinned, many = totals["pinned"].count, totals["many"].count
     assert pinned[1] == many[1] == n, (pinned, many)
@@ -399,12 +414,12 @@ def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
     names them, quotes their insert's count and range and their rounds whose second
     thread began on the first one's vCPU, and their counts in the status cells of the
     targets not met everywhere; the README quotes the same counts."""
-    z = {t.row.key: t for t in sr.totals(zen4)}
+    z = totals_of(zen4)
     n, first, last = len(zen4), zen4[0].name, zen4[-1].name
     every = [r.name for r in zen4 if sr.met_every_target(r.cells)]
 
     def count(key: str) -> str:
-        return "{} of {}".format(*z[key].count)
+        return counted(z, key)
 
     raw = (ROOT / "BENCHMARK.md").read_text()
     lines = raw.splitlines()
@@ -428,7 +443,7 @@ def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
         ("… and", "odometry_peer"),
         ("two Python", "threads"),
     ):
-        (cell,) = [flat(r[-1]) for r in rows[1:] if r[0].startswith(target)]
+        cell = status_cell(rows, target)
         assert f"On the Zen 4 VM of session 65: {count(key)} runs" in cell, (target, cell)
 
     readme = flat((ROOT / "README.md").read_text())
