@@ -84,6 +84,17 @@ HISTORY_ROW = re.compile(
 )
 
 
+def cell_683(table: str, group: str) -> str:
+    """The 683-point 2 cm time of the row ``group`` of a full criterion ``table``, with its
+    row's unit ("48.1 µs")."""
+    row = re.search(rf"^\| {group} \| ([^|\n]+) \|", table, re.MULTILINE)
+    assert row, f"no {group} row in {table[:200]!r}"
+    parts = row[1].split(" / ")
+    assert len(parts) == 4, row[0]
+    unit = parts[-1].split()[-1]
+    return parts[2] if " " in parts[2] else f"{parts[2]} {unit}"
+
+
 def first_table_683(body: str) -> tuple[str, str] | None:
     """The 683-point 2 cm times of the `insert` and `match` rows of ``body``'s first full
     criterion table, each with its row's unit ("48.1 µs"); ``None`` without one."""
@@ -91,15 +102,7 @@ def first_table_683(body: str) -> tuple[str, str] | None:
     if not head:
         return None
     table = body[head.start() :].split("\n\n", 1)[0]
-    cells = []
-    for group in ("insert", "match"):
-        row = re.search(rf"^\| {group} \| ([^|\n]+) \|", table, re.MULTILINE)
-        assert row, f"no {group} row in {table[:200]!r}"
-        parts = row[1].split(" / ")
-        assert len(parts) == 4, row[0]
-        unit = parts[-1].split()[-1]
-        cells.append(parts[2] if " " in parts[2] else f"{parts[2]} {unit}")
-    return cells[0], cells[1]
+    return cell_683(table, "insert"), cell_683(table, "match")
 
 
 def sessions() -> list[tuple[int, int]]:
@@ -182,3 +185,23 @@ def test_the_core_history_quotes_each_sessions_criterion_table() -> None:
     for (session, commit, insert, match), (_, body, cells) in zip(rows, tabled):
         assert commit in body, f"session {session}: no {commit} in its section"
         assert (insert, match) == cells, f"session {session}: {(insert, match)} against {cells}"
+
+
+def test_the_prose_quotes_the_newest_criterion_table() -> None:
+    """The sentences that quote the newest kept criterion table's 683-point insert (into a
+    fresh clone and in the loop's case) and match, BENCHMARK.md's Core introduction, its
+    insert status cell and the README's criterion paragraph, quote its numbers."""
+    session, tabled = kept_tables()[0]
+    insert, loop, match = (cell_683(tabled, g) for g in ("insert", "insert_loop", "match"))
+    core = " ".join(core_section().split())
+    assert f"The newest run, session {session}'s (" in core
+    assert f"the 683-point insert into a fresh clone {insert}" in core
+    assert f"the loop's {loop})" in core
+    bench = (ROOT / "BENCHMARK.md").read_text(encoding="utf-8")
+    target = "| insert of a 683-point scan ≤ 50 µs |"
+    (status,) = [row for row in bench.splitlines() if row.startswith(target)]
+    assert f"(session {session} on the " in status, status
+    assert f": {insert}, the loop's case {loop})" in status, status
+    readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    assert f"on session {session}'s " in readme
+    assert f"{insert} (the loop's case {loop}) and {match}" in readme
