@@ -153,6 +153,12 @@ def flat(text: str) -> str:
     return " ".join(text.split())
 
 
+def short_reasons(text: str) -> str:
+    """BENCHMARK.md's short "Why the misses stay" out of its flattened ``text``."""
+    start = text.index("Why the misses stay, in short")
+    return text[start : text.index("### How this section is laid out", start)]
+
+
 def table(text: str, header: str) -> list[list[str]]:
     """The rows (header first) of the Markdown table whose header line starts with
     ``header``, each a list of its cells, stripped."""
@@ -315,8 +321,7 @@ def test_benchmark_short_reasons_quote_the_runs(
     runs: their counts, and the misses' ranges worked out run by run."""
     raw = (ROOT / "BENCHMARK.md").read_text()
     text = flat(raw)
-    start = text.index("Why the misses stay, in short")
-    why = text[start : text.index("### How this section is laid out", start)]
+    why = short_reasons(text)
     rows = table(raw, "| target (issue 7) | judged by |")
     n = len(runs)
 
@@ -443,13 +448,11 @@ def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
         "in the others)" in text
     )
     # the short "Why the misses stay": the threads' bullet on this VM too
-    start = text.index("Why the misses stay, in short")
-    why = text[start : text.index("### How this section is laid out", start)]
     assert (
         f"On the Zen 4 VM of {ZEN4_SESSIONS} the kernel started the second thread on the "
         f"first one's vCPU in only {r.together} of {r.read} rounds, yet threads started for "
         f"each run met 1.7{TIMES} in {count('threads')} runs: there too, {bundles_fell(zen4)}"
-        in why
+        in short_reasons(text)
     )
     rows = table(raw, "| target (issue 7) | judged by |")
     for target, key in (
