@@ -49,9 +49,15 @@ def section(session: int) -> str:
     return body
 
 
+@functools.cache
+def benchmark() -> str:
+    """BENCHMARK.md's text (read once: it does not change during a test run)."""
+    return (ROOT / "BENCHMARK.md").read_text(encoding="utf-8")
+
+
 def core_section() -> str:
     """BENCHMARK.md's "Core: insert and match" section, its heading to the next."""
-    text = (ROOT / "BENCHMARK.md").read_text(encoding="utf-8")
+    text = benchmark()
     start = text.index("## Core: insert and match")
     return text[start : text.index("\n## ", start)]
 
@@ -150,7 +156,7 @@ def test_every_citation_names_a_session_of_the_log() -> None:
 
 
 def test_no_session_section_left_in_benchmark() -> None:
-    text = (ROOT / "BENCHMARK.md").read_text(encoding="utf-8")
+    text = benchmark()
     assert not re.search(r"^#+ Sessions? \d", text, re.MULTILINE)
     newest = sessions()[0][1]
     assert f"What\neach session from 3 to {newest} measured is in the speed log" in text
@@ -197,9 +203,8 @@ def test_the_prose_quotes_the_newest_criterion_table() -> None:
     assert f"The newest run, session {session}'s (" in core
     assert f"the 683-point insert into a fresh clone {insert}" in core
     assert f"the loop's {loop})" in core
-    bench = (ROOT / "BENCHMARK.md").read_text(encoding="utf-8")
     target = "| insert of a 683-point scan ≤ 50 µs |"
-    (status,) = [row for row in bench.splitlines() if row.startswith(target)]
+    (status,) = [row for row in benchmark().splitlines() if row.startswith(target)]
     assert f"(session {session} on the " in status, status
     assert f": {insert}, the loop's case {loop})" in status, status
     readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())

@@ -41,8 +41,6 @@ RUNS = kept(BENCHES / "runs")
 # model-207 VM's, which the status table's first columns and the README's tables count.
 ZEN4 = kept(BENCHES / "runs" / "zen4")
 ZEN4_MACHINE = "2 cores of AMD EPYC (family 25, model 17, stepping 1)"
-# How the docs name the sessions of the Zen 4 runs (a later session's runs widen it).
-ZEN4_SESSIONS = "sessions 65\N{EN DASH}66"
 
 DASH = "\N{EN DASH}"
 TIMES = "\N{MULTIPLICATION SIGN}"
@@ -416,6 +414,21 @@ def log_tables(lines: list[str]) -> list[tuple[int, list[str], bool]]:
     return found
 
 
+def sessions_printing(names: set[str]) -> str:
+    """The sessions of the speed log whose sections print any of the runs ``names`` in a
+    table, as the docs name them: "session 65", "sessions 65\N{EN DASH}66"."""
+    found: set[int] = set()
+    session = 0
+    for line in (BENCHES / "SPEED_LOG.md").read_text(encoding="utf-8").splitlines():
+        if heading := re.match(r"## Sessions? (\d+)", line):
+            session = int(heading[1])
+        elif line.startswith("| target |") and names & {c.strip() for c in line.split("|")}:
+            found.add(session)
+    assert found, "no section of the speed log prints these runs"
+    first, last = min(found), max(found)
+    return f"session {first}" if first == last else f"sessions {first}{DASH}{last}"
+
+
 def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
     """BENCHMARK.md shows ``speed_runs``' summary of the Zen 4 runs as it prints it,
     names them and the commits they ran at, quotes their insert's count and range and
@@ -425,6 +438,7 @@ def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
     z = totals_of(zen4)
     n, first, last = len(zen4), zen4[0].name, zen4[-1].name
     every = [r.name for r in zen4 if sr.met_every_target(r.cells)]
+    sessions = sessions_printing({r.name for r in zen4})
 
     def count(key: str) -> str:
         return counted(z, key)
@@ -436,7 +450,7 @@ def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
     start = lines.index(want[0])
     assert lines[start : start + len(want)] == want, "not speed_runs' summary of the Zen 4 runs"
     text = flat(raw)
-    assert f"{ZEN4_SESSIONS} (runs {first}{DASH}{last}, {n} runs on a Zen 4 VM" in text
+    assert f"{sessions} (runs {first}{DASH}{last}, {n} runs on a Zen 4 VM" in text
     # each commit the runs name, in the order they first ran at it
     commits = list(dict.fromkeys(r.machine.rsplit("commit ", 1)[-1] for r in zen4))
     assert f"benches/speed_runs.py benches/runs/zen4/run*.json`; at {listed(commits)}, the" in text
@@ -449,7 +463,7 @@ def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
     )
     # the short "Why the misses stay": the threads' bullet on this VM too
     assert (
-        f"On the Zen 4 VM of {ZEN4_SESSIONS} the kernel started the second thread on the "
+        f"On the Zen 4 VM of {sessions} the kernel started the second thread on the "
         f"first one's vCPU in only {r.together} of {r.read} rounds, yet threads started for "
         f"each run met 1.7{TIMES} in {count('threads')} runs: there too, {bundles_fell(zen4)}"
         in short_reasons(text)
@@ -462,7 +476,7 @@ def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
         ("two Python", "threads"),
     ):
         cell = status_cell(rows, target)
-        assert f"On the Zen 4 VM of {ZEN4_SESSIONS}: {count(key)} runs" in cell, (target, cell)
+        assert f"On the Zen 4 VM of {sessions}: {count(key)} runs" in cell, (target, cell)
 
     readme = flat((ROOT / "README.md").read_text())
     assert f"their {n} runs ({first}{DASH}{last}), kept apart in `benches/runs/zen4/`" in readme
