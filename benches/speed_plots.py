@@ -388,3 +388,80 @@ def plot_runs(
     for ax in axes.flat[len(panels) :]:
         ax.set_visible(False)
     return save_figure(fig, title, path)
+
+
+@dataclass(frozen=True)
+class PaceRun:
+    """One run's thread rounds for the pace picture: its name, each round's two-thread
+    ratio (one thread's time over two threads') of the GIL-free bundles and of the two
+    pinned workers, timed one after the other in the round, and whether the run's pinned
+    workers missed their target (by the run's own ratio)."""
+
+    name: str
+    bundles: tuple[float, ...]
+    pinned: tuple[float, ...]
+    missed: bool
+
+    def median_quotient(self) -> float:
+        """The median over the rounds of the pinned workers' ratio over the bundles'."""
+        return float(np.median(np.divide(self.pinned, self.bundles)))
+
+
+def plot_pace(runs: Sequence[PaceRun], limit: float, title: str, path: Path) -> Path | None:
+    """The pinned workers against the GIL-free bundles as a PNG, in two panels: each
+    round's pinned ratio against the same round's bundles' (the rounds of the runs whose
+    pinned workers missed in red, the limit dashed on both axes, equal pace dotted); and
+    run by run the median of the rounds' quotient (the runs whose pinned workers missed
+    ringed in red). ``runs`` in order, each with at least one round. Its path, or
+    ``None`` without matplotlib."""
+    plt = pyplot()
+    if plt is None:
+        return None
+    fig, (rounds, by_run) = plt.subplots(1, 2, figsize=(12, 5.2))
+    for missed, colour, what in ((False, "tab:blue", "met"), (True, "red", "missed")):
+        these = [r for r in runs if r.missed is missed]
+        b = [x for r in these for x in r.bundles]
+        p = [y for r in these for y in r.pinned]
+        rounds.plot(
+            b,
+            p,
+            "o",
+            ms=3,
+            alpha=0.4 if missed is False else 0.8,
+            color=colour,
+            label=f"runs whose pinned workers {what} ({len(these)} runs, {len(b)} rounds)",
+        )
+    every = [v for r in runs for v in (*r.bundles, *r.pinned)]
+    lo, hi = min(every), max(every)
+    rounds.plot([lo, hi], [lo, hi], "k:", lw=0.9, label="equal pace")
+    rounds.axhline(limit, color="k", lw=0.8, ls="--")
+    rounds.axvline(limit, color="k", lw=0.8, ls="--")
+    rounds.set_xlabel("GIL-free bundles: one thread's time / two threads'", fontsize=8)
+    rounds.set_ylabel("two pinned workers: one worker's time / two workers'", fontsize=8)
+    rounds.set_title("each round: the pinned workers against the bundles", fontsize=9)
+    rounds.tick_params(labelsize=7)
+    rounds.legend(fontsize=7, loc="upper left")
+    x = np.arange(len(runs))
+    q = np.array([r.median_quotient() for r in runs])
+    miss = np.array([r.missed for r in runs], dtype=bool)
+    by_run.plot(x, q, "o-", ms=3.5, lw=0.8, label="median over the run's rounds")
+    by_run.plot(
+        x[miss],
+        q[miss],
+        "o",
+        ms=9,
+        mfc="none",
+        mec="red",
+        mew=1.3,
+        label=f"pinned workers missed ({int(miss.sum())} of {len(runs)})",
+    )
+    by_run.axhline(1.0, color="k", lw=0.8, ls=":")
+    step = max(1, math.ceil(len(runs) / 12))
+    by_run.set_xticks(x[::step], [r.name for r in runs][::step], fontsize=7)
+    by_run.tick_params(axis="y", labelsize=7)
+    by_run.set_xlabel("run", fontsize=8)
+    by_run.set_title(
+        "run by run: the pinned workers' ratio / the bundles', round by round", fontsize=9
+    )
+    by_run.legend(fontsize=7, loc="upper left")
+    return save_figure(fig, title, path)

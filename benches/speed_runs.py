@@ -8,7 +8,8 @@ that misses its target is in bold, with one more digit when it rounds onto the l
 (a ratio of 1.695 is no 1.70). Tables of at most ``--columns`` runs; then, over all the runs,
 each row's range and count, and the runs that met every target. A section a run did
 not time reads as a dash and is not judged; such a run did not meet every target.
-``--plot PATH`` also draws each target's numbers run by run (needs matplotlib).
+``--plot PATH`` also draws each target's numbers run by run, ``--plot-pace PATH`` the
+two pinned workers' ratio against the GIL-free bundles' round by round (matplotlib).
 
 Run from the repository root, e.g.::
 
@@ -524,6 +525,30 @@ def target_panels(runs: Sequence[Run]) -> list[speed_plots.TargetPanel]:
     ]
 
 
+def pace_runs(runs: Sequence[Run]) -> list[speed_plots.PaceRun]:
+    """The thread rounds of ``runs`` for ``speed_plots.plot_pace``: each round's ratio of
+    the GIL-free bundles and of the pinned workers (``speed.py``'s ``per_run``), and
+    whether the run's pinned workers missed their row; runs without both in order, as
+    in ``runs``, skipping those that kept neither round by round."""
+    pinned_row = [r.key for r in ROWS].index("pinned")
+    found = []
+    for run in runs:
+        per_run = _get(run.sections, "threads", "per_run") or {}
+        pairs = list(zip(per_run.get("bundles") or (), per_run.get("pinned") or ()))
+        if not pairs:
+            continue
+        cell = run.cells[pinned_row]
+        found.append(
+            speed_plots.PaceRun(
+                run.name,
+                tuple(float(b) for b, _ in pairs),
+                tuple(float(p) for _, p in pairs),
+                cell is not None and cell.met() is False,
+            )
+        )
+    return found
+
+
 def machines(runs: Sequence[Run]) -> list[str]:
     """Each machine (and commit) the runs name, with its runs."""
     seen: dict[str, list[str]] = {}
@@ -541,11 +566,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument(
         "--plot", type=Path, metavar="PATH", help="also draw each target run by run (a PNG)"
     )
+    ap.add_argument(
+        "--plot-pace",
+        type=Path,
+        metavar="PATH",
+        help="also draw the pinned workers against the GIL-free bundles, round by round",
+    )
     args = ap.parse_args(argv)
     if args.columns < 1:
         ap.error(f"--columns: expected an integer >= 1, got {args.columns}")
-    if args.plot is not None and speed_plots.pyplot() is None:
-        ap.error("--plot needs matplotlib (pip install matplotlib)")
+    for option, path in (("--plot", args.plot), ("--plot-pace", args.plot_pace)):
+        if path is not None and speed_plots.pyplot() is None:
+            ap.error(f"{option} needs matplotlib (pip install matplotlib)")
     try:
         runs = [read_run(p, args.partial) for p in args.runs]
     except ValueError as e:
@@ -564,6 +596,21 @@ def main(argv: Sequence[str] | None = None) -> int:
             )
         except OSError as e:
             print(f"error: {args.plot}: {e.strerror}", file=sys.stderr)
+            return 2
+        print(f"\nPicture: {drawn}")
+    if args.plot_pace is not None:
+        paced = pace_runs(runs)
+        if not paced:
+            print("error: --plot-pace: no run kept its thread rounds", file=sys.stderr)
+            return 2
+        title = (
+            f"Two pinned workers against the GIL-free bundles in {len(paced)} runs of "
+            "benches/speed.py"
+        )
+        try:
+            drawn = speed_plots.plot_pace(paced, tg.THREADS_RATIO, title, args.plot_pace)
+        except OSError as e:
+            print(f"error: {args.plot_pace}: {e.strerror}", file=sys.stderr)
             return 2
         print(f"\nPicture: {drawn}")
     return 0

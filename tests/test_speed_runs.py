@@ -292,3 +292,42 @@ def test_the_picture_on_the_command_line(
     with pytest.raises(SystemExit):
         sr.main([str(a), "--plot", str(png)])
     assert "--plot needs matplotlib (pip install matplotlib)" in capsys.readouterr().err
+
+
+def test_the_pinned_workers_against_the_bundles_round_by_round(tmp_path: Path) -> None:
+    kept = copy.deepcopy(SECTIONS)
+    kept["threads"]["per_run"] = {"bundles": [1.5, 2.0, 1.6], "pinned": [1.8, 1.9, 1.6]}
+    missed = copy.deepcopy(kept)
+    missed["threads"]["pinned_ratio"] = 1.62
+    missed["threads"]["per_run"] = {"bundles": [1.4, 1.5], "pinned": [1.54, 1.5]}
+    runs = [
+        sr.read_run(write(tmp_path / f"run{n}.json", s))
+        for n, s in ((1, kept), (2, SECTIONS), (3, missed))
+    ]
+    paced = sr.pace_runs(runs)
+    # run 2 kept no rounds, so it is left out
+    assert [(r.name, r.bundles, r.pinned, r.missed) for r in paced] == [
+        ("1", (1.5, 2.0, 1.6), (1.8, 1.9, 1.6), False),
+        ("3", (1.4, 1.5), (1.54, 1.5), True),
+    ]
+    assert paced[0].median_quotient() == pytest.approx(1.0)  # of 1.2, 0.95 and 1.0
+    assert paced[1].median_quotient() == pytest.approx(1.05)  # of 1.1 and 1.0
+
+
+def test_the_pace_picture_on_the_command_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    s = copy.deepcopy(SECTIONS)
+    s["threads"]["per_run"] = {"bundles": [1.5, 2.0], "pinned": [1.8, 1.9]}
+    a = write(tmp_path / "run1.json", s)
+    png = tmp_path / "pictures" / "pace.png"
+    assert sr.main([str(a), "--plot-pace", str(png)]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert capsys.readouterr().out.endswith(f"\nPicture: {png.resolve()}\n")
+    bare = write(tmp_path / "run2.json", SECTIONS)
+    assert sr.main([str(bare), "--plot-pace", str(png)]) == 2
+    assert capsys.readouterr().err == "error: --plot-pace: no run kept its thread rounds\n"
+    monkeypatch.setattr(sr.speed_plots, "pyplot", lambda: None)
+    with pytest.raises(SystemExit):
+        sr.main([str(a), "--plot-pace", str(png)])
+    assert "--plot-pace needs matplotlib (pip install matplotlib)" in capsys.readouterr().err
