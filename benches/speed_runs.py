@@ -528,8 +528,8 @@ def target_panels(runs: Sequence[Run]) -> list[speed_plots.TargetPanel]:
 def pace_runs(runs: Sequence[Run]) -> list[speed_plots.PaceRun]:
     """The thread rounds of ``runs`` for ``speed_plots.plot_pace``: each round's ratio of
     the GIL-free bundles and of the pinned workers (``speed.py``'s ``per_run``), and
-    whether the run's pinned workers missed their row; runs without both in order, as
-    in ``runs``, skipping those that kept neither round by round."""
+    whether the run's pinned workers missed their row; in the order of ``runs``, leaving
+    out a run that did not keep both round by round."""
     pinned_row = [r.key for r in ROWS].index("pinned")
     found = []
     for run in runs:
