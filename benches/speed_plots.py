@@ -358,6 +358,21 @@ class TargetPanel:
     series: tuple[RunSeries, ...]
 
 
+def _run_by_run(
+    ax: Any, names: Sequence[str], values: Any, miss: Any, label: str, ringed: str | None = None
+) -> None:
+    """``values`` (one per run, in the order of ``names``) as a line on ``ax``, the runs
+    flagged in ``miss`` ringed in red (``ringed``: the rings' legend label), the runs'
+    names on the x axis (about a dozen of them)."""
+    x = np.arange(len(names))
+    ax.plot(x, values, "o-", ms=3.5, lw=0.8, label=label)
+    ax.plot(x[miss], values[miss], "o", ms=9, mfc="none", mec="red", mew=1.3, label=ringed)
+    step = max(1, math.ceil(len(names) / 12))
+    ax.set_xticks(x[::step], list(names[::step]), fontsize=7)
+    ax.tick_params(axis="y", labelsize=7)
+    ax.set_xlabel("run", fontsize=8)
+
+
 def plot_runs(
     names: Sequence[str], panels: Sequence[TargetPanel], title: str, path: Path
 ) -> Path | None:
@@ -371,19 +386,13 @@ def plot_runs(
     cols = 2
     rows = max(1, math.ceil(len(panels) / cols))
     fig, axes = plt.subplots(rows, cols, figsize=(12, 3.3 * rows + 0.6), squeeze=False)
-    x = np.arange(len(names))
-    step = max(1, math.ceil(len(names) / 12))
     for ax, panel in zip(axes.flat, panels):
         for s in panel.series:
             v = np.array([np.nan if y is None else y for y in s.values], dtype=float)
             miss = np.array([m is False for m in s.met], dtype=bool)
-            ax.plot(x, v, "o-", ms=3.5, lw=0.8, label=s.legend())
-            ax.plot(x[miss], v[miss], "o", ms=9, mfc="none", mec="red", mew=1.3)
+            _run_by_run(ax, names, v, miss, s.legend())
         ax.axhline(panel.limit, color="k", lw=0.8, ls="--")
         ax.set_title(panel.title, fontsize=9)
-        ax.set_xticks(x[::step], list(names[::step]), fontsize=7)
-        ax.tick_params(axis="y", labelsize=7)
-        ax.set_xlabel("run", fontsize=8)
         ax.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.2))
     for ax in axes.flat[len(panels) :]:
         ax.set_visible(False)
@@ -441,25 +450,16 @@ def plot_pace(runs: Sequence[PaceRun], limit: float, title: str, path: Path) -> 
     rounds.set_title("each round: the pinned workers against the bundles", fontsize=9)
     rounds.tick_params(labelsize=7)
     rounds.legend(fontsize=7, loc="upper left")
-    x = np.arange(len(runs))
-    q = np.array([r.median_quotient() for r in runs])
     miss = np.array([r.missed for r in runs], dtype=bool)
-    by_run.plot(x, q, "o-", ms=3.5, lw=0.8, label="median over the run's rounds")
-    by_run.plot(
-        x[miss],
-        q[miss],
-        "o",
-        ms=9,
-        mfc="none",
-        mec="red",
-        mew=1.3,
-        label=f"pinned workers missed ({int(miss.sum())} of {len(runs)})",
+    _run_by_run(
+        by_run,
+        [r.name for r in runs],
+        np.array([r.median_quotient() for r in runs]),
+        miss,
+        "median over the run's rounds",
+        f"pinned workers missed ({int(miss.sum())} of {len(runs)})",
     )
     by_run.axhline(1.0, color="k", lw=0.8, ls=":")
-    step = max(1, math.ceil(len(runs) / 12))
-    by_run.set_xticks(x[::step], [r.name for r in runs][::step], fontsize=7)
-    by_run.tick_params(axis="y", labelsize=7)
-    by_run.set_xlabel("run", fontsize=8)
     by_run.set_title(
         "run by run: the pinned workers' ratio / the bundles', round by round", fontsize=9
     )

@@ -373,6 +373,10 @@ class Run:
         the picture (``None`` where the run did not time the row)."""
         return tuple(row.cell(self.sections) for row in ROWS)
 
+    def cell(self, key: str) -> Cell | None:
+        """Its cell in the row of ``ROWS`` whose key is ``key``."""
+        return self.cells[[row.key for row in ROWS].index(key)]
+
 
 def read_run(path: Path, partial: bool = False) -> Run:
     """The run in ``path``.
@@ -530,14 +534,13 @@ def pace_runs(runs: Sequence[Run]) -> list[speed_plots.PaceRun]:
     the GIL-free bundles and of the pinned workers (``speed.py``'s ``per_run``), and
     whether the run's pinned workers missed their row; in the order of ``runs``, leaving
     out a run that did not keep both round by round."""
-    pinned_row = [r.key for r in ROWS].index("pinned")
     found = []
     for run in runs:
         per_run = _get(run.sections, "threads", "per_run") or {}
         pairs = list(zip(per_run.get("bundles") or (), per_run.get("pinned") or ()))
         if not pairs:
             continue
-        cell = run.cells[pinned_row]
+        cell = run.cell("pinned")
         found.append(
             speed_plots.PaceRun(
                 run.name,
@@ -555,6 +558,18 @@ def machines(runs: Sequence[Run]) -> list[str]:
     for r in runs:
         seen.setdefault(r.machine, []).append(r.name)
     return [f"- {m}: runs {', '.join(names)}" for m, names in seen.items()]
+
+
+def _drew(path: Path, draw: Callable[[], Path | None]) -> bool:
+    """Runs ``draw`` (a picture into ``path``) and prints where it went; on an error
+    writing ``path``, says so on stderr and returns ``False``."""
+    try:
+        drawn = draw()
+    except OSError as e:
+        print(f"error: {path}: {e.strerror}", file=sys.stderr)
+        return False
+    print(f"\nPicture: {drawn}")
+    return True
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -590,14 +605,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             f"Issue 7's targets in {len(runs)} runs of benches/speed.py "
             "(dashed: the limit; ringed: a miss)"
         )
-        try:
-            drawn = speed_plots.plot_runs(
+        if not _drew(
+            args.plot,
+            lambda: speed_plots.plot_runs(
                 [r.name for r in runs], target_panels(runs), title, args.plot
-            )
-        except OSError as e:
-            print(f"error: {args.plot}: {e.strerror}", file=sys.stderr)
+            ),
+        ):
             return 2
-        print(f"\nPicture: {drawn}")
     if args.plot_pace is not None:
         paced = pace_runs(runs)
         if not paced:
@@ -607,12 +621,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             f"Two pinned workers against the GIL-free bundles in {len(paced)} runs of "
             "benches/speed.py"
         )
-        try:
-            drawn = speed_plots.plot_pace(paced, tg.THREADS_RATIO, title, args.plot_pace)
-        except OSError as e:
-            print(f"error: {args.plot_pace}: {e.strerror}", file=sys.stderr)
+        if not _drew(
+            args.plot_pace,
+            lambda: speed_plots.plot_pace(paced, tg.THREADS_RATIO, title, args.plot_pace),
+        ):
             return 2
-        print(f"\nPicture: {drawn}")
     return 0
 
 

@@ -286,8 +286,7 @@ def test_benchmark_status_table_quotes_the_runs(runs: list[Any], totals: dict[st
 
 def column(runs: list[Any], key: str) -> list[Any]:
     """Each run's cell in the row ``key`` (``None`` where the run did not time it)."""
-    i = [row.key for row in sr.ROWS].index(key)
-    return [r.cells[i] for r in runs]
+    return [r.cell(key) for r in runs]
 
 
 def missed(runs: list[Any], key: str) -> list[int]:
