@@ -71,7 +71,9 @@ impl CellInfo {
     /// The cell belongs to a small (sub-grid scale) object: most of the scans
     /// that hit it saw it as part of a small cluster (a-1).
     pub fn is_small(&self) -> bool {
-        2 * self.small_observations > self.observations
+        // In u64: a restored map may count up to u32::MAX scans, and twice
+        // that overflows u32.
+        2 * u64::from(self.small_observations) > u64::from(self.observations)
     }
 }
 
@@ -115,6 +117,22 @@ pub fn rarely_seen(
 #[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
+
+    /// A majority of small observations, also at counts whose double does
+    /// not fit a u32 (a restored map's, up to u32::MAX).
+    #[test]
+    fn a_small_majority_at_any_count() {
+        let info = |observations, small_observations| CellInfo {
+            observations,
+            small_observations,
+            ..CellInfo::new(1)
+        };
+        assert!(info(3, 2).is_small());
+        assert!(!info(4, 2).is_small());
+        assert!(info(u32::MAX, 1 << 31).is_small());
+        assert!(!info(u32::MAX, (1 << 31) - 1).is_small());
+        assert!(info(u32::MAX, u32::MAX).is_small());
+    }
 
     #[test]
     fn c_deletes_cells_seen_once_after_a_full_window() {
