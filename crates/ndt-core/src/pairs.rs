@@ -94,14 +94,29 @@ impl Storage {
     /// written; `cell_keys` writes `fresh`, `valid` and `same`. Zeroing the
     /// chunks instead took 4.7 % of the loop's instructions (benches/SPEED_LOG.md,
     /// session 27).
+    ///
+    /// A vector too short grows to `n` exactly, not by doubling: a spare
+    /// reused for a slightly larger scan (a match's pairs of all its points
+    /// and of its rotated starts' fewer points take turns with the spares)
+    /// would otherwise pass [`SPARE_CHUNKS`] at scans of 2048–4096 points
+    /// and be freed at the match's end. With two threads matching at once,
+    /// glibc then handed the freed memory back to the kernel and took it
+    /// again about once every three matches (`madvise`, a TLB shootdown on
+    /// the other CPU, page faults): two Python threads matching 3600-point
+    /// scans of one small map took 1.30× one thread's CPU time, 1.00× with
+    /// exact growth (benches/SPEED_LOG.md, session 68).
     fn sized(mut self, n: usize) -> Self {
-        // `resize` keeps the first `n` as they are (truncating any more).
-        self.chunks.resize(n, Chunk::default());
-        self.keys.resize(n, KeyLanes::default());
-        self.known.resize(n, Known::default());
-        self.fresh.resize(n, KeyLanes::default());
-        self.valid.resize(n, 0);
-        self.same.resize(n, 0);
+        fn exactly<T: Clone>(v: &mut Vec<T>, n: usize, fill: T) {
+            v.reserve_exact(n.saturating_sub(v.len()));
+            // `resize` keeps the first `n` as they are (truncating any more).
+            v.resize(n, fill);
+        }
+        exactly(&mut self.chunks, n, Chunk::default());
+        exactly(&mut self.keys, n, KeyLanes::default());
+        exactly(&mut self.known, n, Known::default());
+        exactly(&mut self.fresh, n, KeyLanes::default());
+        exactly(&mut self.valid, n, 0);
+        exactly(&mut self.same, n, 0);
         self
     }
 }
@@ -667,6 +682,39 @@ mod tests {
         let huge = vec![[0.0, 0.0]; (SPARE_CHUNKS + 1) * LANES];
         drop(ScanPairs::new(&huge, None));
         assert_eq!(SPARE.with(|s| s.borrow().len()), 0);
+    }
+
+    /// A spare reused for a larger scan grows to that scan's chunks
+    /// exactly, so scans of up to `SPARE_CHUNKS` chunks keep their storage
+    /// from one match to the next instead of freeing it (by doubling, 263
+    /// chunks grown to 300 would take 526, over the bound).
+    #[test]
+    fn a_grown_spare_stays_within_the_bound() {
+        let sizes = [SPARE_CHUNKS / 2 + 7, SPARE_CHUNKS / 2 + 44, SPARE_CHUNKS];
+        std::thread::spawn(move || {
+            for chunks in sizes {
+                let points = vec![[0.0, 0.0]; chunks * LANES];
+                drop(ScanPairs::new(&points, None));
+                let kept = SPARE.with(|s| {
+                    s.borrow()
+                        .iter()
+                        .map(|st| {
+                            [
+                                st.chunks.capacity(),
+                                st.keys.capacity(),
+                                st.known.capacity(),
+                                st.fresh.capacity(),
+                                st.valid.capacity(),
+                                st.same.capacity(),
+                            ]
+                        })
+                        .collect::<Vec<_>>()
+                });
+                assert_eq!(kept, vec![[chunks; 6]], "{chunks} chunks");
+            }
+        })
+        .join()
+        .unwrap();
     }
 
     /// Along a random walk of poses (points crossing cells, leaving the map,
