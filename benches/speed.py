@@ -90,6 +90,7 @@ import peers as peer_lib
 import pinned
 import speed_plots
 import steady
+import steal
 import targets as tg
 
 import ndtgrid
@@ -1528,6 +1529,12 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     shared: list[bool | None] = []
     shared_first: list[bool | None] = []
     bundle_1, bundle_2 = [], []
+    # The bundles' rounds, apart: the two threads' CPU time over the wall time, their CPU
+    # time over one thread's for the same work, and the seconds stolen from the guest
+    # during the two-thread run (benches/steal.py; None where it cannot be read).
+    bundle_share, bundle_cost = [], []
+    bundle_steal: list[float | None] = []
+    pin_cost: list[float] = []
     pin_1, pin_2, pin_lates, pin_cpu1, pin_cpu2 = [], [], [], [], []
     many_1, many_2, many_cpu = [], [], []
     steady_1: list[steady.SteadyRun] = []
@@ -1553,10 +1560,14 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             shared_first.append(one_cpu_first)
             same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
             controls.append(control())
-            t1, _, r1 = one(bundles)
-            t2, _, r2, *_ = two(bundles, read_cpu=False)
+            t1, c1, r1 = one(bundles)
+            before = steal.steal_seconds()
+            t2, c2, r2, *_ = two(bundles, read_cpu=False)
+            bundle_steal.append(steal.stolen(before, steal.steal_seconds()))
             bundle_1.append(t1)
             bundle_2.append(t2)
+            bundle_share.append(c2 / t2)
+            bundle_cost.append(c2 / c1)
             same &= all(np.array_equal(a, b) for a, b in zip(r1, r2))
             if workers is not None:
                 # One worker alone, on the two cores in turn (one may be slower).
@@ -1566,6 +1577,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
                 t2, late, c2 = pinned_run([jobs[0::2], jobs[1::2]])
                 pin_cpu1.append(c1)
                 pin_cpu2.append(c2)
+                pin_cost.append(c2 * t2 / (c1 * t1))
                 r2 = in_job_order(pin_sinks)
                 pin_1.append(t1)
                 pin_2.append(t2)
@@ -1605,6 +1617,13 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         "bundles": list(np.divide(bundle_1, bundle_2)),
         "many": list(np.divide(many_1, many_2)),
         "steady": [b.rate / a.rate for a, b in zip(steady_1, steady_2)],
+        # Each round's ratio = share / cost, times the one-thread run's wall over its
+        # CPU: below 2.0 from time the two did not compute (share) or from computing
+        # slower than one thread alone (cost).
+        "bundles_share": bundle_share,
+        "bundles_cost": bundle_cost,
+        "pinned_share": pin_cpu2,
+        "pinned_cost": pin_cost,
     }
 
     def split_by(flags: list[bool | None]) -> tuple[list[float], list[float], int, list[float]]:
@@ -1701,7 +1720,9 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             "Per run (one pinned worker's time over the two's right after it): "
             f"{', '.join(f'{r:.2f}' for r in per_run['pinned'])}; median "
             f"{float(np.median(per_run['pinned'])):.2f}×; the two workers' CPU / "
-            f"wall per run: {', '.join(f'{c:.2f}' for c in pin_cpu2)}. The later worker's first "
+            f"wall per run: {', '.join(f'{c:.2f}' for c in pin_cpu2)}; their CPU time "
+            "over one worker's for the same scans: "
+            f"{', '.join(f'{c:.2f}' for c in pin_cost)}. The later worker's first "
             "match began "
             f"{', '.join(f'{1e6 * x:.0f}' for x in pin_lates)} µs after the first's. "
             "Unpinned, this VM's kernel may wake a thread on the vCPU of the busy thread "
@@ -1711,6 +1732,23 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     else:
         pin_rows, pin_text = [], ["", "Pinned workers: not measured (no two CPUs to pin to)."]
     bundle_points = int(np.median([len(p) for p, _ in bundles]))
+    stolen_s = [x for x in bundle_steal if x is not None]
+    # A round's ratio = share / cost, times one thread's wall over its CPU, so the two
+    # lists say where a round below twice one thread's pace lost it: time not computed,
+    # or slower computing.
+    bundle_text = (
+        "Per run, the two threads' CPU / wall: "
+        f"{', '.join(f'{c:.2f}' for c in bundle_share)}; their CPU time over one "
+        "thread's for the same bundles (1.00: each computed as fast as one thread alone): "
+        f"{', '.join(f'{c:.2f}' for c in bundle_cost)}. "
+        + (
+            f"Time stolen from the VM's vCPUs (`/proc/stat`'s steal, `benches/steal.py`) "
+            f"during the two-thread runs: {1e3 * sum(stolen_s):.0f} ms in all, in "
+            f"{sum(x > 0 for x in stolen_s)} of {len(stolen_s)} runs."
+            if stolen_s
+            else "Time stolen from the VM's vCPUs: not read (no `/proc/stat`)."
+        )
+    )
     out(
         [
             f"Map: the 910 corrected Intel scans (2 cm, {len(grid)} cells, distributions "
@@ -1768,7 +1806,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
             "the two threads of single scans can reach on these cores in this run; below "
             "it, the cost is the GIL's (held for the argument conversion, the result and "
             "the Python loop, a few µs per match) and that of waking a thread that waits "
-            "for it.",
+            "for it. " + bundle_text,
             *pin_text,
             "",
             f"`match_many`: the same {n} scans and guesses in one `NdtGrid.match_many` call "
@@ -1818,7 +1856,22 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         # lists of them by place are left out, the flags below give them), the second
         # thread's start after the clock (s), and whether the two threads were on one
         # vCPU at their first matches and half-way through (None: not read).
-        "per_run": {k: per_run[k] for k in ("unpinned", "pinned", "bundles", "many", "steady")},
+        "per_run": {
+            k: per_run[k]
+            for k in (
+                "unpinned",
+                "pinned",
+                "bundles",
+                "many",
+                "steady",
+                "bundles_share",
+                "bundles_cost",
+                "pinned_share",
+                "pinned_cost",
+            )
+        },
+        # The seconds stolen from the guest during each bundles' two-thread run.
+        "bundles_steal_s": bundle_steal,
         "late_s": lates,
         "one_cpu_first": shared_first,
         "one_cpu_half": shared,

@@ -8,8 +8,12 @@ that misses its target is in bold, with one more digit when it rounds onto the l
 (a ratio of 1.695 is no 1.70). Tables of at most ``--columns`` runs; then, over all the runs,
 each row's range and count, and the runs that met every target. A section a run did
 not time reads as a dash and is not judged; such a run did not meet every target.
-``--plot PATH`` also draws each target's numbers run by run, ``--plot-pace PATH`` the
-two pinned workers' ratio against the GIL-free bundles' round by round (matplotlib).
+Runs that kept their thread rounds' CPU times (``speed.py`` since session 68) also
+get a table of the GIL-free bundles' and the pinned workers' rounds under the threads'
+limit and the others: the CPU time over the wall time, over one thread's, and the time
+stolen from the VM's vCPUs. ``--plot PATH`` also draws each target's numbers run by
+run, ``--plot-pace PATH`` the two pinned workers' ratio against the GIL-free bundles'
+round by round (matplotlib).
 
 Run from the repository root, e.g.::
 
@@ -22,6 +26,7 @@ from __future__ import annotations
 import argparse
 import json
 import re
+import statistics
 import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -552,6 +557,92 @@ def pace_runs(runs: Sequence[Run]) -> list[speed_plots.PaceRun]:
     return found
 
 
+@dataclass(frozen=True)
+class Shortfall:
+    """The two-thread rounds of one kind over the runs that kept their CPU time
+    (``speed.py`` since session 68): how many, how many fell under the threads' limit,
+    and the medians of the two threads' CPU time over the wall time (``share``) and
+    over one thread's for the same work (``cost``) in those (``under``) and in the
+    others (``met``); a round's ratio is share / cost, times the one-thread run's wall
+    over its CPU, so a round under the limit lost its pace to time not computed or to
+    slower computing. ``stolen_s``: the seconds stolen from the VM's vCPUs during the
+    rounds (``benches/steal.py``), with the rounds in which any was, or ``None`` where
+    not read."""
+
+    kind: str
+    rounds: int
+    under: int
+    share: tuple[float | None, float | None]
+    cost: tuple[float | None, float | None]
+    stolen_s: tuple[float, int] | None
+
+
+def _median(xs: Sequence[float]) -> float | None:
+    return statistics.median(xs) if xs else None
+
+
+def shortfalls(runs: Sequence[Run]) -> list[Shortfall]:
+    """The GIL-free bundles' and the pinned workers' rounds of ``runs`` (see
+    :class:`Shortfall`), each kind that at least one run kept."""
+    found = []
+    for kind, name in (("bundles", "GIL-free bundles"), ("pinned", "pinned workers")):
+        rows: list[tuple[float, float, float]] = []
+        stolen: list[float] = []
+        for run in runs:
+            threads = _get(run.sections, "threads") or {}
+            per_run = threads.get("per_run") or {}
+            kept = zip(
+                per_run.get(kind) or (),
+                per_run.get(f"{kind}_share") or (),
+                per_run.get(f"{kind}_cost") or (),
+            )
+            rows += [(float(r), float(s), float(c)) for r, s, c in kept]
+            if kind == "bundles" and per_run.get("bundles_share"):
+                stolen += [float(x) for x in threads.get("bundles_steal_s") or () if x is not None]
+        if not rows:
+            continue
+        under = [r for r in rows if r[0] < tg.THREADS_RATIO]
+        met = [r for r in rows if r[0] >= tg.THREADS_RATIO]
+        found.append(
+            Shortfall(
+                name,
+                len(rows),
+                len(under),
+                (_median([r[1] for r in under]), _median([r[1] for r in met])),
+                (_median([r[2] for r in under]), _median([r[2] for r in met])),
+                (sum(stolen), sum(x > 0 for x in stolen)) if stolen else None,
+            )
+        )
+    return found
+
+
+def shortfall_lines(runs: Sequence[Run]) -> list[str]:
+    """:func:`shortfalls` as a table, or nothing where no run kept its CPU times."""
+    found = shortfalls(runs)
+    if not found:
+        return []
+
+    def pair(values: tuple[float | None, float | None]) -> str:
+        return " / ".join("–" if v is None else f"{v:.2f}" for v in values)
+
+    def stolen(s: Shortfall) -> str:
+        if s.stolen_s is None:
+            return "–"
+        return f"{1e3 * s.stolen_s[0]:.0f} ms, in {s.stolen_s[1]} rounds"
+
+    return [
+        f"| two-thread rounds | rounds | under {tg.THREADS_TEXT} | CPU / wall (median: "
+        "under / the others) | CPU over one thread's (median: under / the others) "
+        "| stolen from the vCPUs |",
+        "|---|---|---|---|---|---|",
+        *(
+            f"| {s.kind} | {s.rounds} | {s.under} | {pair(s.share)} | {pair(s.cost)} "
+            f"| {stolen(s)} |"
+            for s in found
+        ),
+    ]
+
+
 def machines(runs: Sequence[Run]) -> list[str]:
     """Each machine (and commit) the runs name, with its runs."""
     seen: dict[str, list[str]] = {}
@@ -600,6 +691,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     print("\n".join(["Machines:", *machines(runs), "", *run_tables(runs, args.columns)]))
     print("\n" + "\n".join(summary(runs)))
+    if lines := shortfall_lines(runs):
+        print("\n" + "\n".join(lines))
     if args.plot is not None:
         title = (
             f"Issue 7's targets in {len(runs)} runs of benches/speed.py "

@@ -59,15 +59,32 @@ def test_the_thread_section_as_json(tmp_path: Path) -> None:
     # --quick: three one- and two-thread runs, each with its ratio, start and CPUs.
     runs = len(t["late_s"])
     assert runs == 3
-    assert set(t["per_run"]) == {"unpinned", "pinned", "bundles", "many", "steady"}
-    for key in ("unpinned", "bundles", "many"):
+    assert set(t["per_run"]) == {
+        *("unpinned", "pinned", "bundles", "many", "steady"),
+        *("bundles_share", "bundles_cost", "pinned_share", "pinned_cost"),
+    }
+    for key in ("unpinned", "bundles", "many", "bundles_share", "bundles_cost"):
         assert len(t["per_run"][key]) == runs
+    # The bundles' rounds apart: CPU over wall of two threads (at most 2 and a little for
+    # the clocks), their CPU time over one thread's, and the seconds stolen meanwhile;
+    # the printed section lists the same numbers.
+    assert all(0.0 < x <= 2.05 for x in t["per_run"]["bundles_share"])
+    assert all(x > 0.0 for x in t["per_run"]["bundles_cost"])
+    assert len(t["bundles_steal_s"]) == runs
+    assert all(x is None or x >= 0.0 for x in t["bundles_steal_s"])
+    shares = ", ".join(f"{x:.2f}" for x in t["per_run"]["bundles_share"])
+    costs = ", ".join(f"{x:.2f}" for x in t["per_run"]["bundles_cost"])
+    assert f"Per run, the two threads' CPU / wall: {shares}; their CPU time over one " in (
+        proc.stdout
+    )
+    assert f"as fast as one thread alone): {costs}. Time stolen" in proc.stdout
     # --quick: two rounds of threads that keep matching for 0.2 s.
     assert len(t["per_run"]["steady"]) == 2
     assert t["steady_seconds"] == 0.2
     # Pinned workers need two CPUs; without them their ratio is NaN, null in the JSON.
     pinned = t["pinned_ratio"] is not None
-    assert len(t["per_run"]["pinned"]) == (runs if pinned else 0)
+    for key in ("pinned", "pinned_share", "pinned_cost"):
+        assert len(t["per_run"][key]) == (runs if pinned else 0)
     assert len(t["one_cpu_first"]) == len(t["one_cpu_half"]) == runs
     assert t["late_runs"] == sum(x >= speed.LATE_START for x in t["late_s"])
     # The printed targets row says what the JSON holds.

@@ -331,3 +331,42 @@ def test_the_pace_picture_on_the_command_line(
     with pytest.raises(SystemExit):
         sr.main([str(a), "--plot-pace", str(png)])
     assert "--plot-pace needs matplotlib (pip install matplotlib)" in capsys.readouterr().err
+
+
+def test_the_rounds_under_the_limit_and_their_cpu_times(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    kept = copy.deepcopy(SECTIONS)
+    kept["threads"]["per_run"] = {
+        "bundles": [1.5, 2.0, 1.6],
+        "bundles_share": [1.9, 1.98, 1.7],
+        "bundles_cost": [1.3, 1.0, 1.1],
+        "pinned": [1.8, 1.6],
+        "pinned_share": [1.96, 1.8],
+        "pinned_cost": [1.05, 1.1],
+    }
+    kept["threads"]["bundles_steal_s"] = [0.0, 0.01, None]
+    older = copy.deepcopy(SECTIONS)  # a run from before session 68: ratios alone
+    older["threads"]["per_run"] = {"bundles": [1.0], "pinned": [1.0]}
+    runs = [sr.read_run(write(tmp_path / f"run{n}.json", s)) for n, s in ((1, kept), (2, older))]
+    bundles, pinned = sr.shortfalls(runs)
+    # under the limit: rounds 1 and 3 (medians of two), the others: round 2
+    assert (bundles.kind, bundles.rounds, bundles.under) == ("GIL-free bundles", 3, 2)
+    assert bundles.share == pytest.approx((1.8, 1.98))
+    assert bundles.cost == pytest.approx((1.2, 1.0))
+    assert bundles.stolen_s == (pytest.approx(0.01), 1)
+    assert (pinned.kind, pinned.rounds, pinned.under) == ("pinned workers", 2, 1)
+    assert pinned.share == pytest.approx((1.8, 1.96))
+    assert pinned.cost == pytest.approx((1.1, 1.05))
+    assert pinned.stolen_s is None
+    lines = sr.shortfall_lines(runs)
+    assert lines[2:] == [
+        "| GIL-free bundles | 3 | 2 | 1.80 / 1.98 | 1.20 / 1.00 | 10 ms, in 1 rounds |",
+        f"| pinned workers | 2 | 1 | 1.80 / 1.96 | 1.10 / 1.05 | {DASH} |",
+    ]
+    # Runs that kept no CPU times get no table, on the command line neither.
+    assert sr.shortfalls(runs[1:]) == [] and sr.shortfall_lines(runs[1:]) == []
+    assert sr.main([str(tmp_path / "run2.json")]) == 0
+    assert "two-thread rounds" not in capsys.readouterr().out
+    assert sr.main([str(tmp_path / "run1.json")]) == 0
+    assert lines[-1] in capsys.readouterr().out.splitlines()
