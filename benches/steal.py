@@ -26,7 +26,8 @@ def parse_steal(text: str) -> int:
     Raises
     ------
     ValueError
-        If the text has no ``cpu`` line with a whole number of ticks eighth.
+        If the text has no ``cpu`` line, or one without a whole number as its eighth
+        value.
     """
     for line in text.splitlines():
         fields = line.split()
