@@ -362,6 +362,8 @@ ROWS = (
     ),
     Row("memory", "memory", False, _memory),
 )
+# Each row's place in ROWS, by its key (Run.cell).
+ROW_INDEX = {row.key: i for i, row in enumerate(ROWS)}
 
 
 @dataclass(frozen=True)
@@ -380,7 +382,7 @@ class Run:
 
     def cell(self, key: str) -> Cell | None:
         """Its cell in the row of ``ROWS`` whose key is ``key``."""
-        return self.cells[[row.key for row in ROWS].index(key)]
+        return self.cells[ROW_INDEX[key]]
 
 
 def read_run(path: Path, partial: bool = False) -> Run:
