@@ -6,8 +6,8 @@
 //! then a scan of `points` points taken at (0.1 m, −0.05 m, 0.3 rad) is
 //! matched `n` times from 3 cm / 2 cm / 1° off, with
 //! `MatchOptions::parallel` when the third argument is 1; prints the median
-//! match and the pose (its bits: `{:?}`), which the thread count must not
-//! change. `RAYON_NUM_THREADS=1` gives the parallel layout on one thread.
+//! match, its iterations and time a point and iteration, and the pose (its
+//! bits: `{:?}`), which the thread count must not change. `RAYON_NUM_THREADS=1` gives the parallel layout on one thread.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -47,10 +47,16 @@ fn main() -> Result<(), Box<dyn Error>> {
         black_box(grid.match_scan(black_box(&scan), guess, &options)?);
         times.push(t0.elapsed().as_secs_f64());
     }
+    let time = median(&mut times);
+    // Scans of other sizes may take another number of Newton steps: the
+    // time a point and step compares them.
+    let per_step = time / (scan.len() as f64 * f64::from(result.iterations.max(1)));
     println!(
-        "{} points, parallel {parallel}: median {:.3} ms over {rounds} matches; pose {:?}",
+        "{} points, parallel {parallel}: median {:.3} ms over {rounds} matches, {} iterations ({:.1} ns a point an iteration); pose {:?}",
         scan.len(),
-        median(&mut times) * 1e3,
+        time * 1e3,
+        result.iterations,
+        per_step * 1e9,
         result.pose
     );
     Ok(())
