@@ -124,10 +124,13 @@ impl Storage {
 /// Storages a thread keeps at most.
 const SPARE_STORAGES: usize = 8;
 
-/// Chunks a kept storage holds at most (4096 points, about 0.5 MB; the
-/// Intel log's scans take 23): a thread keeps at most `SPARE_STORAGES` of
-/// them.
-const SPARE_CHUNKS: usize = 512;
+/// Chunks a kept storage holds at most: those of the largest scan whose
+/// pairs a match keeps ([`crate::matcher::KEPT_MAX_POINTS`], 4096 points,
+/// 512 chunks, about 0.5 MB; the Intel log's scans take 23), so that no
+/// match's storage is freed at its end (a larger scan goes through
+/// [`evaluate_streaming`]'s block); a thread keeps at most
+/// `SPARE_STORAGES` of them.
+const SPARE_CHUNKS: usize = crate::matcher::KEPT_MAX_POINTS.div_ceil(LANES);
 
 thread_local! {
     static SPARE: RefCell<Vec<Storage>> = const { RefCell::new(Vec::new()) };
@@ -715,6 +718,28 @@ mod tests {
         })
         .join()
         .unwrap();
+    }
+
+    /// A match of the largest scan whose pairs it keeps
+    /// (`KEPT_MAX_POINTS`) leaves their storage to its thread for the next
+    /// match: the bound takes it.
+    #[test]
+    fn the_largest_kept_scan_leaves_its_storage() {
+        use crate::matcher::{MatchOptions, KEPT_MAX_POINTS};
+        let wall: Vec<[f64; 2]> = (0..KEPT_MAX_POINTS)
+            .map(|i| [i as f64 * 0.001, 0.5 + 0.003 * (i % 4) as f64])
+            .collect();
+        let mut grid = NdtGrid::new(0.02).unwrap();
+        grid.insert(&wall, Pose2::identity()).unwrap();
+        let largest = std::thread::spawn(move || {
+            let guess = Pose2::new(0.004, -0.003, 0.0);
+            grid.match_scan(&wall, guess, &MatchOptions::default())
+                .unwrap();
+            SPARE.with(|s| s.borrow().iter().map(|st| st.chunks.capacity()).max())
+        })
+        .join()
+        .unwrap();
+        assert_eq!(largest, Some(KEPT_MAX_POINTS.div_ceil(LANES)));
     }
 
     /// Along a random walk of poses (points crossing cells, leaving the map,
