@@ -7,7 +7,8 @@
 //! matched `n` times from 3 cm / 2 cm / 1° off, with
 //! `MatchOptions::parallel` when the third argument is 1; prints the median
 //! match, its iterations and time a point and iteration, and the pose (its
-//! bits: `{:?}`), which the thread count must not change. `RAYON_NUM_THREADS=1` gives the parallel layout on one thread.
+//! bits: `{:?}`), which the thread count must not change.
+//! `RAYON_NUM_THREADS=1` gives the parallel layout on one thread.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
