@@ -1733,9 +1733,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
         pin_rows, pin_text = [], ["", "Pinned workers: not measured (no two CPUs to pin to)."]
     bundle_points = int(np.median([len(p) for p, _ in bundles]))
     stolen_s = [x for x in bundle_steal if x is not None]
-    # A round's ratio = share / cost, times one thread's wall over its CPU, so the two
-    # lists say where a round below twice one thread's pace lost it: time not computed,
-    # or slower computing.
+    # The bundles' share and cost per round (see per_run above for what they tell).
     bundle_text = (
         "Per run, the two threads' CPU / wall: "
         f"{', '.join(f'{c:.2f}' for c in bundle_share)}; their CPU time over one "
