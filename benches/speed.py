@@ -239,6 +239,22 @@ def apply(pose: npt.ArrayLike, pts: F64) -> F64:
     return convergence.apply(np.asarray(pose, dtype=float), pts)
 
 
+def bundle_scans(
+    pts: Sequence[F64], poses: F64, size: int, rng: np.random.Generator
+) -> list[tuple[F64, F64]]:
+    """Bundles of ``size`` consecutive scans, each merged into one scan in the frame of
+    its middle scan (the ``size // 2``-th), as ``(points, start)`` pairs; each start is
+    ±5 cm, ±2° off the middle scan's pose, drawn from ``rng`` bundle after bundle. The
+    scans after the last whole bundle are left out. The thread section's GIL-free
+    control (``THREAD_BUNDLE`` scans) and ``benches/large_bundles.py`` match them."""
+    bundles = []
+    for k in range(0, len(pts) - size + 1, size):
+        ref = poses[k + size // 2]
+        merged = np.vstack([apply(se2.between(ref, poses[j]), pts[j]) for j in range(k, k + size)])
+        bundles.append((merged, ref + convergence.starts(rng, 1, 0.05, 2.0)[0]))
+    return bundles
+
+
 def linear_fit(x: npt.ArrayLike, y: npt.ArrayLike) -> tuple[float, float, float]:
     """Least-squares ``y = slope * x + intercept``; returns slope, intercept, R²."""
     xa, ya = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
@@ -1376,13 +1392,7 @@ def section_threads(args: argparse.Namespace) -> dict[str, Any]:
     # about a millisecond), so that the GIL is held for a fraction of a per cent of the
     # time: what two threads gain on this very code, with the GIL out of the way, in the
     # same run and on the same cores.
-    bundles = []
-    for k in range(0, len(pts) - THREAD_BUNDLE + 1, THREAD_BUNDLE):
-        ref = poses[k + THREAD_BUNDLE // 2]
-        merged = np.vstack(
-            [apply(se2.between(ref, poses[j]), pts[j]) for j in range(k, k + THREAD_BUNDLE)]
-        )
-        bundles.append((merged, ref + convergence.starts(rng, 1, 0.05, 2.0)[0]))
+    bundles = bundle_scans(pts, poses, THREAD_BUNDLE, rng)
 
     def work(
         part: Sequence[tuple[F64, F64]],
