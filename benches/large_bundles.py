@@ -19,7 +19,7 @@ the other; ``turns`` turns, so that a spell of the machine falls on every case, 
 table gives each turn's medians side by side.
 
 Run from the repository root (needs ``pip install -e ".[bench]"`` and
-``../shared/data/real``; about 6 min with the defaults on 2 shared cores)::
+``../shared/data/real``; about a minute with the defaults on 2 shared cores)::
 
     python benches/large_bundles.py > out/large_bundles.md
     python benches/large_bundles.py --sizes 20 80 --maps 910 --turns 1
