@@ -246,7 +246,15 @@ def bundle_scans(
     its middle scan (the ``size // 2``-th), as ``(points, start)`` pairs; each start is
     ±5 cm, ±2° off the middle scan's pose, drawn from ``rng`` bundle after bundle. The
     scans after the last whole bundle are left out. The thread section's GIL-free
-    control (``THREAD_BUNDLE`` scans) and ``benches/large_bundles.py`` match them."""
+    control (``THREAD_BUNDLE`` scans) and ``benches/large_bundles.py`` match them.
+
+    Raises
+    ------
+    ValueError
+        If ``size`` is below 1.
+    """
+    if size < 1:
+        raise ValueError(f"a bundle holds at least 1 scan, not {size}")
     bundles = []
     for k in range(0, len(pts) - size + 1, size):
         ref = poses[k + size // 2]

@@ -49,6 +49,13 @@ def test_bundles_draw_their_starts_from_the_generator_in_order() -> None:
         )
 
 
+@pytest.mark.parametrize("size", [0, -3])
+def test_a_bundle_of_no_scans_is_refused(size: int) -> None:
+    pts, poses = scans(4)
+    with pytest.raises(ValueError, match=rf"^a bundle holds at least 1 scan, not {size}$"):
+        speed.bundle_scans(pts, poses, size, np.random.default_rng(0))
+
+
 def test_cases_put_sizes_first_and_leave_out_maps_smaller_than_a_bundle() -> None:
     assert large.cases([20, 80], [60, 910], 910) == [(20, 60), (20, 910), (80, 910)]
 
