@@ -2,8 +2,10 @@
 ``python benches/speed_runs.py RUN.json [RUN.json ...]``.
 
 Each run is a column, named by the first number in its file's name (``run539.json``:
-539), else by the name; each of issue 7's targets is a row (``benches/targets.py``
-holds the limits, the judging is ``speed.py``'s), with how many runs met it. A number
+539), else by the name, in the order of those numbers (``run999.json`` before
+``run1000.json``, whatever order the shell's ``run*.json`` gave); each of issue 7's
+targets is a row (``benches/targets.py`` holds the limits, the judging is
+``speed.py``'s), with how many runs met it. A number
 that misses its target is in bold, with one more digit when it rounds onto the limit
 (a ratio of 1.695 is no 1.70). Tables of at most ``--columns`` runs; then, over all the runs,
 each row's range and count, and the runs that met every target. A section a run did
@@ -411,6 +413,18 @@ def read_run(path: Path, partial: bool = False) -> Run:
     )
 
 
+def in_run_order(paths: Sequence[Path]) -> list[Path]:
+    """``paths`` ordered by the first number in each file's name, as the runs' columns
+    are named (a shell's ``run*.json`` puts ``run1000.json`` before ``run999.json``);
+    names without a number follow, in the order given."""
+
+    def key(path: Path) -> tuple[int, int]:
+        number = re.search(r"\d+", path.stem)
+        return (0, int(number.group())) if number else (1, 0)
+
+    return sorted(paths, key=key)
+
+
 def met_every_target(cells: Sequence[Cell | None]) -> bool:
     """Whether a run's cells meet every target row (a row not timed is no pass)."""
     return all(c is not None and c.met() is True for c, r in zip(cells, ROWS) if r.target)
@@ -668,7 +682,12 @@ def _drew(path: Path, draw: Callable[[], Path | None]) -> bool:
 def main(argv: Sequence[str] | None = None) -> int:
     """Print the tables of the runs named on the command line."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("runs", nargs="+", type=Path, help="speed.py --json files, in order")
+    ap.add_argument(
+        "runs",
+        nargs="+",
+        type=Path,
+        help="speed.py --json files; shown in the order of the numbers in their names",
+    )
     ap.add_argument("--columns", type=int, default=8, help="runs per table (default 8)")
     ap.add_argument("--partial", action="store_true", help="also runs that stopped part-way")
     ap.add_argument(
@@ -687,7 +706,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if path is not None and speed_plots.pyplot() is None:
             ap.error(f"{option} needs matplotlib (pip install matplotlib)")
     try:
-        runs = [read_run(p, args.partial) for p in args.runs]
+        runs = [read_run(p, args.partial) for p in in_run_order(args.runs)]
     except ValueError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

@@ -35,7 +35,7 @@ ROOT = BENCHES.parent
 
 def kept(folder: Path) -> list[Path]:
     """The runs kept in ``folder``, in the order of their numbers."""
-    return sorted(folder.glob("run*.json"), key=lambda p: int(re.sub(r"\D", "", p.stem) or 0))
+    return sr.in_run_order(list(folder.glob("run*.json")))
 
 
 RUNS = kept(BENCHES / "runs")

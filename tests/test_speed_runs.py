@@ -210,6 +210,19 @@ def test_the_command_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
     assert "--columns: expected an integer >= 1, got 0" in capsys.readouterr().err
 
 
+def test_runs_in_the_order_of_their_numbers(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A shell's run*.json lists run1000.json before run999.json.
+    names = ("run1000", "run999", "notes", "run0")
+    paths = [write(tmp_path / f"{n}.json", SECTIONS) for n in names]
+    assert sr.in_run_order(paths) == [paths[3], paths[1], paths[0], paths[2]]
+    assert sr.main([str(p) for p in paths]) == 0
+    out = capsys.readouterr().out
+    assert "| target | 0 | 999 | 1000 | notes | met |" in out.splitlines()
+    assert out.endswith("Every target met in 4 of 4 runs: 0, 999, 1000, notes.\n")
+
+
 def test_the_judged_numbers_run_by_run(tmp_path: Path) -> None:
     slow = copy.deepcopy(SECTIONS)
     slow["insert"]["sim URG-04LX 683 beams (true poses)"]["ours"] = 5.43e-5
