@@ -5,11 +5,11 @@ Each run is a column, named by the first number in its file's name (``run539.jso
 539), else by the name, in the order of those numbers (``run999.json`` before
 ``run1000.json``, whatever order the shell's ``run*.json`` gave); each of issue 7's
 targets is a row (``benches/targets.py`` holds the limits, the judging is
-``speed.py``'s), with how many runs met it. A number
-that misses its target is in bold, with one more digit when it rounds onto the limit
-(a ratio of 1.695 is no 1.70). Tables of at most ``--columns`` runs; then, over all the runs,
-each row's range and count, and the runs that met every target. A section a run did
-not time reads as a dash and is not judged; such a run did not meet every target.
+``speed.py``'s), with how many runs met it. A number that misses its target is in bold,
+with one more digit when it rounds onto the limit (a ratio of 1.695 is no 1.70). Tables
+of at most ``--columns`` runs; then, over all the runs, each row's range and count, and
+the runs that met every target. A section a run did not time reads as a dash and is not
+judged; such a run did not meet every target.
 Runs that kept their thread rounds' CPU times (``speed.py`` since session 68) also
 get a table of the GIL-free bundles' and the pinned workers' rounds under the threads'
 limit and the others: the CPU time over the wall time, over one thread's, and the time
