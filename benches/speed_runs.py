@@ -407,10 +407,16 @@ def read_run(path: Path, partial: bool = False) -> Run:
         raise ValueError(f'{path}: not a `speed.py --json` document (no "sections")')
     if doc.get("complete") is not True and not partial:
         raise ValueError(f"{path}: the run stopped part-way; --partial tables what it measured")
-    number = re.search(r"\d+", path.stem)
+    number = _number_in(path)
     return Run(
-        number.group() if number else path.stem, str(doc.get("machine", "?")), doc["sections"]
+        path.stem if number is None else number, str(doc.get("machine", "?")), doc["sections"]
     )
+
+
+def _number_in(path: Path) -> str | None:
+    """The first number in ``path``'s file name, which names its run (``None``: none)."""
+    number = re.search(r"\d+", path.stem)
+    return None if number is None else number.group()
 
 
 def in_run_order(paths: Sequence[Path]) -> list[Path]:
@@ -419,8 +425,8 @@ def in_run_order(paths: Sequence[Path]) -> list[Path]:
     names without a number follow, in the order given."""
 
     def key(path: Path) -> tuple[int, int]:
-        number = re.search(r"\d+", path.stem)
-        return (0, int(number.group())) if number else (1, 0)
+        number = _number_in(path)
+        return (1, 0) if number is None else (0, int(number))
 
     return sorted(paths, key=key)
 
