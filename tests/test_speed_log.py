@@ -6,7 +6,8 @@ does not resolve, or BENCHMARK.md naming a different last session fails here; so
 a session whose criterion results are kept (``benches/criterion/sessionN.json``) without
 their table, as ``benches/criterion_table.py --from`` prints it, in its section; and
 BENCHMARK.md's Core section not showing the newest kept table, or its history of the
-sessions' criterion tables quoting a 683-point time other than the session's own.
+sessions' criterion tables quoting a 683-point time other than the session's own; or the
+README's ranges over the Zen 4 VM's kept tables not the ones those tables give.
 """
 
 from __future__ import annotations
@@ -210,3 +211,52 @@ def test_the_prose_quotes_the_newest_criterion_table() -> None:
     readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
     assert f"on session {session}'s " in readme
     assert f"{insert} (the loop's case {loop}) and {match}" in readme
+
+
+def _micro(cell: str) -> float:
+    """``cell_683``'s "48.1 µs" as a number of µs."""
+    value, unit = cell.split()
+    assert unit == "µs", cell
+    return float(value)
+
+
+def _listed(sessions: list[int]) -> str:
+    """The sessions as the README lists them: "65", "65 and 68", "68, 69 and 71"."""
+    names = [str(s) for s in sessions]
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+
+
+def test_the_readme_quotes_the_zen4_criterion_ranges() -> None:
+    """The README's criterion paragraph sums up the kept criterion tables of the Zen 4 VM
+    (family 25, model 17): the ranges of the 683-point insert into a fresh clone, the
+    loop's insert and the match over those sessions, and the sessions whose inserts were
+    over the 50 µs target, as the kept files give them."""
+    ct = load_bench("criterion_table")
+    zen4 = {
+        int(path.stem.removeprefix("session"))
+        for path in (BENCHES / "criterion").glob("session*.json")
+        if "family 25, model 17," in ct.load(path)[1]
+    }
+    tables = {session: table for session, table in kept_tables() if session in zen4}
+    assert len(tables) >= 2, f"kept Zen 4 tables: {sorted(tables)}"
+    first, last = min(tables), max(tables)
+    assert sorted(tables) == list(range(first, last + 1)), sorted(tables)
+
+    def spread(group: str) -> tuple[str, list[int]]:
+        cells = {s: cell_683(t, group) for s, t in tables.items()}
+        values = {s: _micro(c) for s, c in cells.items()}
+        low, high = min(values.values()), max(values.values())
+        over = sorted(s for s, v in values.items() if v > 50.0)
+        return f"{low:.1f}\u2013{high:.1f} µs", over
+
+    insert, insert_over = spread("insert")
+    loop, loop_over = spread("insert_loop")
+    match, _ = spread("match")
+    assert insert_over and loop_over, "the sentence below names sessions over the target"
+    readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    quote = (
+        f"the insert took {insert} (the loop's case {loop}) and the match {match} in the "
+        f"`cargo bench` runs of sessions {first}\u2013{last}, the insert over 50 µs in "
+        f"sessions {_listed(insert_over)} and the loop's case in {_listed(loop_over)}"
+    )
+    assert quote in readme, quote
