@@ -226,11 +226,12 @@ def _listed(sessions: list[int]) -> str:
     return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
 
 
-def test_the_readme_quotes_the_zen4_criterion_ranges() -> None:
-    """The README's criterion paragraph sums up the kept criterion tables of the Zen 4 VM
-    (family 25, model 17): the ranges of the 683-point insert into a fresh clone, the
-    loop's insert and the match over those sessions, and the sessions whose inserts were
-    over the 50 µs target, as the kept files give them."""
+def test_the_docs_quote_the_zen4_criterion_ranges() -> None:
+    """The README's criterion paragraph and BENCHMARK.md's status table (its Zen 4
+    `cargo bench` cell) sum up the kept criterion tables of the Zen 4 VM (family 25,
+    model 17): the ranges of the 683-point insert into a fresh clone, the loop's insert
+    and the match over those sessions, the newest session, and (the README) the sessions
+    whose inserts were over the 50 µs target, as the kept files give them."""
     ct = load_bench("criterion_table")
     zen4 = {
         int(path.stem.removeprefix("session"))
@@ -260,3 +261,10 @@ def test_the_readme_quotes_the_zen4_criterion_ranges() -> None:
         f"sessions {_listed(insert_over)} and the loop's case in {_listed(loop_over)}"
     )
     assert quote in readme, quote
+    flat_benchmark = " ".join(benchmark().split())
+    assert f"the full table, session {last} (" in flat_benchmark, last
+    assert (
+        f"over sessions {first}\u2013{last}, the same core and VM: the 683-point insert into a "
+        f"fresh clone {insert}, in the loop's case {loop}, the 683-point match {match};"
+        in flat_benchmark
+    ), (insert, loop, match)
