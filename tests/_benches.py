@@ -1,5 +1,6 @@
-"""Loading a module of ``benches/`` (not a package) into the tests, and reading the
-Markdown tables the benches print and the docs quote."""
+"""Loading a module of ``benches/`` (not a package) into the tests, reading the
+Markdown tables the benches print and the docs quote, and what more than one test file
+matches the docs against."""
 
 from __future__ import annotations
 
@@ -9,6 +10,9 @@ from pathlib import Path
 from types import ModuleType
 
 BENCHES = Path(__file__).resolve().parents[1] / "benches"
+# The machine line's start of the Zen 4 VM of sessions 65 on, in `speed.py`'s runs and
+# in `criterion_table.py --save`'s files alike.
+ZEN4_MACHINE = "2 cores of AMD EPYC (family 25, model 17, stepping 1)"
 
 
 def load_bench(name: str) -> ModuleType:
@@ -25,3 +29,9 @@ def load_bench(name: str) -> ModuleType:
 def cells(line: str) -> list[str]:
     """The cells of one Markdown table row, stripped."""
     return [c.strip() for c in line.strip().strip("|").split("|")]
+
+
+def listed(names: list[str]) -> str:
+    """``names`` as the docs' prose lists them: "a", "a and b", "a, b and c"."""
+    assert names, "nothing to list"
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]

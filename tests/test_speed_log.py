@@ -17,7 +17,7 @@ import os
 import re
 from pathlib import Path
 
-from tests._benches import BENCHES, load_bench
+from tests._benches import BENCHES, ZEN4_MACHINE, listed, load_bench
 
 ROOT = BENCHES.parent
 LOG = BENCHES / "SPEED_LOG.md"
@@ -64,10 +64,10 @@ def core_section() -> str:
 
 
 @functools.cache
-def kept_tables() -> list[tuple[int, str]]:
-    """Each kept criterion file's session and its table, from its header to its targets, as
-    ``benches/criterion_table.py --from`` prints it (the first line, naming where the file
-    was read, left out), newest first."""
+def kept_files() -> list[tuple[int, str, str]]:
+    """Each kept criterion file's session, machine line and table, from its header to its
+    targets, as ``benches/criterion_table.py --from`` prints it (the first line, naming
+    where the file was read, left out), newest first."""
     ct = load_bench("criterion_table")
     kept = []
     for path in (BENCHES / "criterion").glob("session*.json"):
@@ -75,9 +75,15 @@ def kept_tables() -> list[tuple[int, str]]:
         assert "+ uncommitted changes" not in machine, f"{path.name}: {machine}"
         lines = ct.lines_of(est)
         table = "\n".join(lines[lines.index("") + 1 :])
-        kept.append((int(path.stem.removeprefix("session")), table))
+        kept.append((int(path.stem.removeprefix("session")), machine, table))
     assert kept, "no criterion results kept in benches/criterion/"
     return sorted(kept, reverse=True)
+
+
+def kept_tables() -> list[tuple[int, str]]:
+    """Each kept criterion file's session and its table (:func:`kept_files`), newest
+    first."""
+    return [(session, table) for session, _, table in kept_files()]
 
 
 # A full criterion table's header (at a line's start), as `benches/criterion_table.py`
@@ -220,34 +226,22 @@ def _micro(cell: str) -> float:
     return float(value)
 
 
-def _listed(sessions: list[int]) -> str:
-    """The sessions as the README lists them: "65", "65 and 68", "68, 69 and 71"."""
-    names = [str(s) for s in sessions]
-    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
-
-
 def test_the_docs_quote_the_zen4_criterion_ranges() -> None:
     """The README's criterion paragraph and BENCHMARK.md's status table (its Zen 4
     `cargo bench` cell) sum up the kept criterion tables of the Zen 4 VM (family 25,
     model 17): the ranges of the 683-point insert into a fresh clone, the loop's insert
     and the match over those sessions, the newest session, and (the README) the sessions
     whose inserts were over the 50 µs target, as the kept files give them."""
-    ct = load_bench("criterion_table")
-    zen4 = {
-        int(path.stem.removeprefix("session"))
-        for path in (BENCHES / "criterion").glob("session*.json")
-        if "family 25, model 17," in ct.load(path)[1]
-    }
-    tables = {session: table for session, table in kept_tables() if session in zen4}
+    tables = {s: table for s, machine, table in kept_files() if machine.startswith(ZEN4_MACHINE)}
     assert len(tables) >= 2, f"kept Zen 4 tables: {sorted(tables)}"
     first, last = min(tables), max(tables)
     assert sorted(tables) == list(range(first, last + 1)), sorted(tables)
 
-    def spread(group: str) -> tuple[str, list[int]]:
+    def spread(group: str) -> tuple[str, list[str]]:
         cells = {s: cell_683(t, group) for s, t in tables.items()}
         values = {s: _micro(c) for s, c in cells.items()}
         low, high = min(values.values()), max(values.values())
-        over = sorted(s for s, v in values.items() if v > 50.0)
+        over = [str(s) for s in sorted(values) if values[s] > 50.0]
         return f"{low:.1f}\u2013{high:.1f} µs", over
 
     insert, insert_over = spread("insert")
@@ -258,7 +252,7 @@ def test_the_docs_quote_the_zen4_criterion_ranges() -> None:
     quote = (
         f"the insert took {insert} (the loop's case {loop}) and the match {match} in the "
         f"`cargo bench` runs of sessions {first}\u2013{last}, the insert over 50 µs in "
-        f"sessions {_listed(insert_over)} and the loop's case in {_listed(loop_over)}"
+        f"sessions {listed(insert_over)} and the loop's case in {listed(loop_over)}"
     )
     assert quote in readme, quote
     flat_benchmark = " ".join(benchmark().split())

@@ -27,7 +27,7 @@ from typing import Any, NamedTuple, Optional
 
 import pytest
 
-from tests._benches import BENCHES, cells, load_bench
+from tests._benches import BENCHES, ZEN4_MACHINE, cells, listed, load_bench
 
 sr = load_bench("speed_runs")
 ROOT = BENCHES.parent
@@ -46,7 +46,6 @@ RUNS = kept(BENCHES / "runs")
 ZEN4_COLUMNS = [2, 3]
 MODEL207_COLUMNS = [4, 5]
 ZEN4 = kept(BENCHES / "runs" / "zen4")
-ZEN4_MACHINE = "2 cores of AMD EPYC (family 25, model 17, stepping 1)"
 
 DASH = "\N{EN DASH}"
 TIMES = "\N{MULTIPLICATION SIGN}"
@@ -296,12 +295,6 @@ def column(runs: list[Any], key: str) -> list[Any]:
 def missed(runs: list[Any], key: str) -> list[int]:
     """The indices of the runs that missed the row ``key``'s target."""
     return [i for i, c in enumerate(column(runs, key)) if c is not None and c.met() is False]
-
-
-def listed(names: list[str]) -> str:
-    """``names`` as prose lists them: "a, b and c"."""
-    assert names, "no run to list"
-    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
 
 
 def bundles_fell(runs: list[Any]) -> str:
