@@ -31,6 +31,11 @@ def cells(line: str) -> list[str]:
     return [c.strip() for c in line.strip().strip("|").split("|")]
 
 
+def flat(text: str) -> str:
+    """``text`` with each run of white space one space, as a reader sees it."""
+    return " ".join(text.split())
+
+
 def listed(names: list[str]) -> str:
     """``names`` as the docs' prose lists them: "a", "a and b", "a, b and c"."""
     assert names, "nothing to list"

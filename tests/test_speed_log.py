@@ -17,7 +17,7 @@ import os
 import re
 from pathlib import Path
 
-from tests._benches import BENCHES, ZEN4_MACHINE, listed, load_bench
+from tests._benches import BENCHES, ZEN4_MACHINE, flat, listed, load_bench
 
 ROOT = BENCHES.parent
 LOG = BENCHES / "SPEED_LOG.md"
@@ -54,6 +54,12 @@ def section(session: int) -> str:
 def benchmark() -> str:
     """BENCHMARK.md's text (read once: it does not change during a test run)."""
     return (ROOT / "BENCHMARK.md").read_text(encoding="utf-8")
+
+
+@functools.cache
+def readme() -> str:
+    """The README's text as a reader sees it, white space runs one space (read once)."""
+    return flat((ROOT / "README.md").read_text(encoding="utf-8"))
 
 
 def core_section() -> str:
@@ -206,7 +212,7 @@ def test_the_prose_quotes_the_newest_criterion_table() -> None:
     insert status cell and the README's criterion paragraph, quote its numbers."""
     session, tabled = kept_tables()[0]
     insert, loop, match = (cell_683(tabled, g) for g in ("insert", "insert_loop", "match"))
-    core = " ".join(core_section().split())
+    core = flat(core_section())
     assert f"The newest run, session {session}'s (" in core
     assert f"the 683-point insert into a fresh clone {insert}" in core
     assert f"the loop's {loop})" in core
@@ -214,9 +220,8 @@ def test_the_prose_quotes_the_newest_criterion_table() -> None:
     (status,) = [row for row in benchmark().splitlines() if row.startswith(target)]
     assert f"(session {session} on the " in status, status
     assert f": {insert}, the loop's case {loop})" in status, status
-    readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
-    assert f"on session {session}'s " in readme
-    assert f"{insert} (the loop's case {loop}) and {match}" in readme
+    assert f"on session {session}'s " in readme()
+    assert f"{insert} (the loop's case {loop}) and {match}" in readme()
 
 
 def _micro(cell: str) -> float:
@@ -248,14 +253,13 @@ def test_the_docs_quote_the_zen4_criterion_ranges() -> None:
     loop, loop_over = spread("insert_loop")
     match, _ = spread("match")
     assert insert_over and loop_over, "the sentence below names sessions over the target"
-    readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
     quote = (
         f"the insert took {insert} (the loop's case {loop}) and the match {match} in the "
         f"`cargo bench` runs of sessions {first}\u2013{last}, the insert over 50 µs in "
         f"sessions {listed(insert_over)} and the loop's case in {listed(loop_over)}"
     )
-    assert quote in readme, quote
-    flat_benchmark = " ".join(benchmark().split())
+    assert quote in readme(), quote
+    flat_benchmark = flat(benchmark())
     assert f"the full table, session {last} (" in flat_benchmark, last
     assert (
         f"over sessions {first}\u2013{last}, the same core and VM: the 683-point insert into a "

@@ -27,7 +27,7 @@ from typing import Any, NamedTuple, Optional
 
 import pytest
 
-from tests._benches import BENCHES, ZEN4_MACHINE, cells, listed, load_bench
+from tests._benches import BENCHES, ZEN4_MACHINE, cells, flat, listed, load_bench
 
 sr = load_bench("speed_runs")
 ROOT = BENCHES.parent
@@ -149,11 +149,6 @@ def rounds_of(runs: list[Any]) -> Rounds:
 @pytest.fixture(scope="module")
 def rounds(runs: list[Any]) -> Rounds:
     return rounds_of(runs)
-
-
-def flat(text: str) -> str:
-    """``text`` with each run of white space one space, as a reader sees it."""
-    return " ".join(text.split())
 
 
 def short_reasons(text: str) -> str:
