@@ -4,12 +4,14 @@ matches the docs against."""
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 import sys
 from pathlib import Path
 from types import ModuleType
 
-BENCHES = Path(__file__).resolve().parents[1] / "benches"
+ROOT = Path(__file__).resolve().parents[1]
+BENCHES = ROOT / "benches"
 # The machine line's start of the Zen 4 VM of sessions 65 on, in `speed.py`'s runs and
 # in `criterion_table.py --save`'s files alike.
 ZEN4_MACHINE = "2 cores of AMD EPYC (family 25, model 17, stepping 1)"
@@ -24,6 +26,13 @@ def load_bench(name: str) -> ModuleType:
     sys.modules[spec.name] = module
     spec.loader.exec_module(module)
     return module
+
+
+@functools.cache
+def doc(path: str) -> str:
+    """The text of the project's file at ``path`` (from the root: ``README.md``,
+    ``BENCHMARK.md``, ``benches/SPEED_LOG.md``), read once for every test that quotes it."""
+    return (ROOT / path).read_text(encoding="utf-8")
 
 
 def cells(line: str) -> list[str]:

@@ -17,9 +17,8 @@ import os
 import re
 from pathlib import Path
 
-from tests._benches import BENCHES, ZEN4_MACHINE, flat, listed, load_bench
+from tests._benches import BENCHES, ROOT, ZEN4_MACHINE, doc, flat, listed, load_bench
 
-ROOT = BENCHES.parent
 LOG = BENCHES / "SPEED_LOG.md"
 
 # "## Session 59 (…" or "## Sessions 22\u201323 (…" (an en dash, \u2013)
@@ -38,7 +37,7 @@ SKIP_DIRS = {"target", "__pycache__", "node_modules"}
 def sections() -> list[tuple[int, int, str]]:
     """Each section's sessions, first and last, and its text (its heading to the next), in
     the log's order."""
-    text = LOG.read_text(encoding="utf-8")
+    text = doc("benches/SPEED_LOG.md")
     heads = list(HEADING.finditer(text))
     ends = [m.start() for m in heads[1:]] + [len(text)]
     return [(int(m[1]), int(m[2] or m[1]), text[m.start() : end]) for m, end in zip(heads, ends)]
@@ -50,16 +49,15 @@ def section(session: int) -> str:
     return body
 
 
-@functools.cache
 def benchmark() -> str:
-    """BENCHMARK.md's text (read once: it does not change during a test run)."""
-    return (ROOT / "BENCHMARK.md").read_text(encoding="utf-8")
+    """BENCHMARK.md's text (read once, by :func:`doc`)."""
+    return doc("BENCHMARK.md")
 
 
 @functools.cache
 def readme() -> str:
     """The README's text as a reader sees it, white space runs one space (read once)."""
-    return flat((ROOT / "README.md").read_text(encoding="utf-8"))
+    return flat(doc("README.md"))
 
 
 def core_section() -> str:
@@ -176,7 +174,7 @@ def test_no_session_section_left_in_benchmark() -> None:
 
 
 def test_the_logs_links_resolve() -> None:
-    text = LOG.read_text(encoding="utf-8")
+    text = doc("benches/SPEED_LOG.md")
     links = re.findall(r"\]\(([^)\s]+)\)", text)
     assert links
     for link in links:

@@ -27,10 +27,9 @@ from typing import Any, NamedTuple, Optional
 
 import pytest
 
-from tests._benches import BENCHES, ZEN4_MACHINE, cells, flat, listed, load_bench
+from tests._benches import BENCHES, ZEN4_MACHINE, cells, doc, flat, listed, load_bench
 
 sr = load_bench("speed_runs")
-ROOT = BENCHES.parent
 
 
 def kept(folder: Path) -> list[Path]:
@@ -243,7 +242,7 @@ def test_the_zen4_runs_are_of_one_zen4_and_kept_apart(runs: list[Any], zen4: lis
 
 
 def test_readme_quotes_the_runs(runs: list[Any], totals: dict[str, Any], rounds: Rounds) -> None:
-    text = (ROOT / "README.md").read_text()
+    text = doc("README.md")
     n, first, last = len(runs), runs[0].name, runs[-1].name
     intro = text[text.index("### Issue 7's targets, against the peers") :]
     intro = flat(intro[: intro.index("| target (issue 7) |")])
@@ -270,7 +269,7 @@ def test_readme_quotes_the_runs(runs: list[Any], totals: dict[str, Any], rounds:
 
 
 def test_benchmark_status_table_quotes_the_runs(runs: list[Any], totals: dict[str, Any]) -> None:
-    text = (ROOT / "BENCHMARK.md").read_text()
+    text = doc("BENCHMARK.md")
     rows = table(text, "| target (issue 7) | judged by |")
     n, first, last = len(runs), runs[0].name, runs[-1].name
     assert f"runs {first}{DASH}{last}" in rows[0][MODEL207_COLUMNS[0]]
@@ -350,7 +349,7 @@ def test_benchmark_short_reasons_quote_the_runs(
 ) -> None:
     """The short "Why the misses stay" and the status cells BENCHMARK.md words from the
     runs: their counts, and the misses' ranges worked out run by run."""
-    raw = (ROOT / "BENCHMARK.md").read_text()
+    raw = doc("BENCHMARK.md")
     text = flat(raw)
     why = short_reasons(text)
     rows = table(raw, "| target (issue 7) | judged by |")
@@ -452,7 +451,7 @@ def sessions_printing(names: set[str]) -> str:
     table, as the docs name them: "session 65", "sessions 65\N{EN DASH}66"."""
     found: set[int] = set()
     session = 0
-    for line in (BENCHES / "SPEED_LOG.md").read_text(encoding="utf-8").splitlines():
+    for line in doc("benches/SPEED_LOG.md").splitlines():
         if heading := re.match(r"## Sessions? (\d+)", line):
             session = int(heading[1])
         elif line.startswith("| target |") and names & {c.strip() for c in line.split("|")}:
@@ -476,7 +475,7 @@ def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
     def count(key: str) -> str:
         return counted(z, key)
 
-    raw = (ROOT / "BENCHMARK.md").read_text()
+    raw = doc("BENCHMARK.md")
     lines = raw.splitlines()
     want = sr.summary(zen4)
     assert want[0] in lines, f"BENCHMARK.md shows no {want[0]!r}"
@@ -519,7 +518,7 @@ def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
         cell = status_cell(rows, target)
         assert f"On the Zen 4 VM of {sessions}: {count(key)} runs" in cell, (target, cell)
 
-    readme = flat((ROOT / "README.md").read_text())
+    readme = flat(doc("README.md"))
     assert f"their {n} runs ({first}{DASH}{last}), kept apart in `benches/runs/zen4/`" in readme
     assert (
         f"met the match in {count('match')}, the insert in {count('insert')} "
@@ -537,7 +536,7 @@ def test_the_speed_log_prints_the_kept_runs_as_speed_runs_does(
     are ``speed_runs``' summary of the per-run tables above it in its section, since the
     summary before; every kept run is in one of those tables."""
     by_name = {r.name: r for r in [*runs, *zen4]}
-    lines = (BENCHES / "SPEED_LOG.md").read_text(encoding="utf-8").splitlines()
+    lines = doc("benches/SPEED_LOG.md").splitlines()
     printed: list[str] = []
     batch: list[str] = []
     for start, rows, new_section in log_tables(lines):
