@@ -260,7 +260,7 @@ def test_the_docs_quote_the_zen4_criterion_ranges() -> None:
     flat_benchmark = flat(benchmark())
     assert f"the full table, session {last} (" in flat_benchmark, last
     assert (
-        f"over sessions {first}\u2013{last}, the same core and VM: the 683-point insert into a "
-        f"fresh clone {insert}, in the loop's case {loop}, the 683-point match {match};"
+        f"over sessions {first}\u2013{last}, the same core and VM kind: the 683-point insert "
+        f"into a fresh clone {insert}, in the loop's case {loop}, the 683-point match {match};"
         in flat_benchmark
     ), (insert, loop, match)
