@@ -35,6 +35,12 @@ def doc(path: str) -> str:
     return (ROOT / path).read_text(encoding="utf-8")
 
 
+@functools.cache
+def flat_doc(path: str) -> str:
+    """:func:`doc`'s text of ``path`` as :func:`flat` gives it, worked out once."""
+    return flat(doc(path))
+
+
 def cells(line: str) -> list[str]:
     """The cells of one Markdown table row, stripped."""
     return [c.strip() for c in line.strip().strip("|").split("|")]

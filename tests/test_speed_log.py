@@ -17,7 +17,16 @@ import os
 import re
 from pathlib import Path
 
-from tests._benches import BENCHES, ROOT, ZEN4_MACHINE, doc, flat, listed, load_bench
+from tests._benches import (
+    BENCHES,
+    ROOT,
+    ZEN4_MACHINE,
+    doc,
+    flat,
+    flat_doc,
+    listed,
+    load_bench,
+)
 
 LOG = BENCHES / "SPEED_LOG.md"
 
@@ -54,10 +63,9 @@ def benchmark() -> str:
     return doc("BENCHMARK.md")
 
 
-@functools.cache
 def readme() -> str:
-    """The README's text as a reader sees it, white space runs one space (read once)."""
-    return flat(doc("README.md"))
+    """The README's text as a reader sees it, white space runs one space (by :func:`flat_doc`)."""
+    return flat_doc("README.md")
 
 
 def core_section() -> str:
@@ -257,7 +265,7 @@ def test_the_docs_quote_the_zen4_criterion_ranges() -> None:
         f"sessions {listed(insert_over)} and the loop's case in {listed(loop_over)}"
     )
     assert quote in readme(), quote
-    flat_benchmark = flat(benchmark())
+    flat_benchmark = flat_doc("BENCHMARK.md")
     assert f"the full table, session {last} (" in flat_benchmark, last
     assert (
         f"over sessions {first}\u2013{last}, the same core and VM kind: the 683-point insert "

@@ -27,7 +27,16 @@ from typing import Any, NamedTuple, Optional
 
 import pytest
 
-from tests._benches import BENCHES, ZEN4_MACHINE, cells, doc, flat, listed, load_bench
+from tests._benches import (
+    BENCHES,
+    ZEN4_MACHINE,
+    cells,
+    doc,
+    flat,
+    flat_doc,
+    listed,
+    load_bench,
+)
 
 sr = load_bench("speed_runs")
 
@@ -252,7 +261,7 @@ def test_readme_quotes_the_runs(runs: list[Any], totals: dict[str, Any], rounds:
     threads = table(text, "| two threads … |")
     assert f"{n} runs)" in threads[0][1]
     check(threads, [1], README_THREADS, totals)
-    prose = flat(text)
+    prose = flat_doc("README.md")
     assert (
         f"on the first one's vCPU in {rounds.together} of {rounds.read} rounds, which gave a "
         f"median {rounds.together_median:.2f}{TIMES} against {rounds.others_median:.2f}{TIMES} "
@@ -274,7 +283,7 @@ def test_benchmark_status_table_quotes_the_runs(runs: list[Any], totals: dict[st
     n, first, last = len(runs), runs[0].name, runs[-1].name
     assert f"runs {first}{DASH}{last}" in rows[0][MODEL207_COLUMNS[0]]
     check(rows, MODEL207_COLUMNS, BENCHMARK_STATUS, totals)
-    prose = flat(text)
+    prose = flat_doc("BENCHMARK.md")
     assert f"(runs {first}{DASH}{last}, {n} runs on Intel" in prose
     assert f"The {n} runs are kept in `benches/runs/`" in prose
     assert f"Each target's numbers in the {n} runs" in prose
@@ -350,7 +359,7 @@ def test_benchmark_short_reasons_quote_the_runs(
     """The short "Why the misses stay" and the status cells BENCHMARK.md words from the
     runs: their counts, and the misses' ranges worked out run by run."""
     raw = doc("BENCHMARK.md")
-    text = flat(raw)
+    text = flat_doc("BENCHMARK.md")
     why = short_reasons(text)
     rows = table(raw, "| target (issue 7) | judged by |")
     n = len(runs)
@@ -481,7 +490,7 @@ def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
     assert want[0] in lines, f"BENCHMARK.md shows no {want[0]!r}"
     start = lines.index(want[0])
     assert lines[start : start + len(want)] == want, "not speed_runs' summary of the Zen 4 runs"
-    text = flat(raw)
+    text = flat_doc("BENCHMARK.md")
     assert f"{sessions} (runs {first}{DASH}{last}, {n} runs on a Zen 4 VM" in text
     # each commit the runs name, in the order they first ran at it
     commits = list(dict.fromkeys(r.machine.rsplit("commit ", 1)[-1] for r in zen4))
@@ -518,7 +527,7 @@ def test_the_docs_quote_the_zen4_runs(zen4: list[Any]) -> None:
         cell = status_cell(rows, target)
         assert f"On the Zen 4 VM of {sessions}: {count(key)} runs" in cell, (target, cell)
 
-    readme = flat(doc("README.md"))
+    readme = flat_doc("README.md")
     assert f"their {n} runs ({first}{DASH}{last}), kept apart in `benches/runs/zen4/`" in readme
     assert (
         f"met the match in {count('match')}, the insert in {count('insert')} "
